@@ -1,0 +1,113 @@
+// Asset: a loaded mesh file that remembers its whole document, so that saving writes back
+// everything unchanged except the positions (and normals) of what was computed.
+//
+// Supported: glTF 2.0 (.gltf with external or data-URI buffers, .glb), OBJ (polygons
+// fan-triangulated), OFF, PLY (ascii, binary little/big endian).
+//
+// glTF: all TRIANGLES primitives of the default scene (or scene 0) are loaded, in node
+// traversal order, with their node's world transform applied (V_raw is in world space).
+// Other primitive modes (points, lines, strips, fans) make the load fail with Unsupported
+// unless LoadOptions::skip_unsupported_primitives is set (then they are left untouched).
+// The raw layout (V_raw/F_raw) concatenates primitives; the geometry mesh every algorithm
+// uses is the welded one (glTF splits vertices at UV/normal seams; see mesh/weld.h).
+//
+// Security: external URIs of a .gltf are resolved only inside the file's own folder; absolute
+// paths, "..", and URI schemes other than data: are refused with IoError.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/status.h"
+#include "mesh/mesh.h"
+#include "mesh/weld.h"
+
+namespace mm::io {
+
+enum class Format { Gltf, Glb, Obj, Off, Ply };
+
+// Format from a file name's extension (case-insensitive); nullopt when unknown.
+std::optional<Format> format_from_path(const std::string& path);
+const char* format_name(Format f);
+
+// One loaded glTF primitive instance (or the single "primitive" of an OBJ/OFF/PLY file).
+struct PrimitiveRef {
+  int node = -1;           // glTF node index (-1 for non-glTF)
+  int mesh = -1;           // glTF mesh index
+  int primitive = -1;      // index within the mesh
+  int first_vertex = 0;    // range in V_raw
+  int num_vertices = 0;
+  int first_face = 0;      // range in F_raw
+  int num_faces = 0;
+  bool skinned = false;    // node has a skin (positions are the bind pose)
+  Eigen::Matrix4d world = Eigen::Matrix4d::Identity();  // node world transform
+  std::string name;        // "<node name>/<mesh name>#<primitive>"
+};
+
+class Document;  // format-specific contents (tinygltf::Model, OBJ lines, PLY properties)
+
+struct Asset {
+  Format format = Format::Obj;
+  std::string source_name;            // file name as given (diagnostics only)
+  Eigen::MatrixXd V_raw;              // #R by 3, world space, original vertex layout
+  Eigen::MatrixXi F_raw;              // triangles over V_raw
+  std::vector<PrimitiveRef> primitives;
+  WeldResult weld;                    // welded mesh over V_raw (weld.V, weld.F, weld.to_welded)
+  std::vector<std::string> warnings;  // non-fatal issues met while loading
+  std::shared_ptr<const Document> document;  // kept for saving; shared, immutable
+
+  // The geometry mesh (welded).
+  Mesh mesh() const { return {weld.V, weld.F}; }
+};
+
+struct LoadOptions {
+  WeldOptions weld;                         // tolerance for welding seam-split vertices
+  bool skip_unsupported_primitives = false; // glTF: leave non-triangle primitives alone
+};
+
+struct LoadResult {
+  Status status;
+  Asset asset;
+};
+
+// Reads external files referenced by a .gltf (buffers/images) by their URI relative to the
+// .gltf. Returns false when missing. The browser passes the sibling files the user dropped.
+using FileResolver = std::function<bool(const std::string& uri, std::vector<uint8_t>* bytes)>;
+
+LoadResult load_asset(const std::string& path, const LoadOptions& opt = {});
+LoadResult load_asset_from_memory(const std::vector<uint8_t>& bytes, Format format,
+                                  const std::string& name, const FileResolver& resolver = {},
+                                  const LoadOptions& opt = {});
+
+struct SaveOptions {
+  bool recompute_normals = true;  // glTF: NORMAL of changed primitives recomputed from the result
+};
+
+// Writes the asset with new welded positions V (#W by 3, world space; pass asset.weld.V to
+// keep the geometry). When the output format equals the input format, everything else in the
+// document is kept (glTF: accessors, materials, textures, nodes, skins, animations; OBJ: UVs,
+// normals, groups, materials; PLY: extra properties). Converting between formats keeps what
+// the target format can hold. glTF output for a changed primitive gets new POSITION (and
+// NORMAL) accessors in local space (inverse node transform) with correct min/max.
+Status save_asset(const Asset& asset, const Eigen::MatrixXd& V, const std::string& path,
+                  const SaveOptions& opt = {});
+Status save_asset_to_memory(const Asset& asset, const Eigen::MatrixXd& V, Format format,
+                            std::vector<uint8_t>* bytes, const SaveOptions& opt = {});
+
+// Writes a plain mesh (no source document) in the format of `path`'s extension.
+// Optional per-vertex colors (#V by 3 in 0..1) are written as COLOR_0 / PLY red,green,blue.
+Status save_mesh(const std::string& path, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                 const Eigen::MatrixXd& colors = {});
+Status save_mesh_to_memory(Format format, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                           std::vector<uint8_t>* bytes, const Eigen::MatrixXd& colors = {});
+
+// Reads a whole file; IoError with the path in the message when it fails.
+Status read_file(const std::string& path, std::vector<uint8_t>* bytes);
+
+}  // namespace mm::io

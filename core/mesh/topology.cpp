@@ -1,0 +1,139 @@
+#include "mesh/topology.h"
+
+#include <algorithm>
+#include <map>
+#include <numeric>
+
+namespace mm {
+
+std::vector<std::vector<int>> vertex_adjacency(const Eigen::MatrixXi& F, int n) {
+  std::vector<std::vector<int>> adj(n);
+  for (int f = 0; f < F.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      const int a = F(f, c), b = F(f, (c + 1) % 3);
+      if (a == b || a < 0 || b < 0 || a >= n || b >= n) continue;
+      adj[a].push_back(b);
+      adj[b].push_back(a);
+    }
+  }
+  for (auto& list : adj) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  return adj;
+}
+
+std::vector<int> k_ring(const std::vector<std::vector<int>>& adjacency, int seed, int k) {
+  return k_ring(adjacency, std::vector<int>{seed}, k);
+}
+
+std::vector<int> k_ring(const std::vector<std::vector<int>>& adjacency,
+                        const std::vector<int>& seeds, int k) {
+  std::vector<char> seen(adjacency.size(), 0);
+  std::vector<int> frontier, result;
+  for (int s : seeds) {
+    if (s < 0 || s >= static_cast<int>(adjacency.size()) || seen[s]) continue;
+    seen[s] = 1;
+    frontier.push_back(s);
+    result.push_back(s);
+  }
+  for (int ring = 0; ring < k && !frontier.empty(); ++ring) {
+    std::vector<int> next;
+    for (int v : frontier)
+      for (int w : adjacency[v])
+        if (!seen[w]) {
+          seen[w] = 1;
+          next.push_back(w);
+          result.push_back(w);
+        }
+    frontier.swap(next);
+  }
+  std::sort(result.begin(), result.end());
+  return result;
+}
+
+Eigen::VectorXi vertex_components(const Eigen::MatrixXi& F, int n, int* count) {
+  // Union-find with path halving; ids assigned in order of the smallest vertex.
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&parent](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (int f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      const int a = F(f, c), b = F(f, (c + 1) % 3);
+      if (a < 0 || b < 0 || a >= n || b >= n) continue;
+      const int ra = find(a), rb = find(b);
+      if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+    }
+  Eigen::VectorXi comp(n);
+  std::vector<int> id_of_root(n, -1);
+  int next = 0;
+  for (int v = 0; v < n; ++v) {
+    const int r = find(v);
+    if (id_of_root[r] < 0) id_of_root[r] = next++;
+    comp[v] = id_of_root[r];
+  }
+  if (count) *count = next;
+  return comp;
+}
+
+std::vector<EdgeUse> edge_uses(const Eigen::MatrixXi& F) {
+  std::vector<std::pair<long long, int>> keys;
+  keys.reserve(F.rows() * 3);
+  for (int f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      int a = F(f, c), b = F(f, (c + 1) % 3);
+      if (a == b) continue;
+      if (a > b) std::swap(a, b);
+      keys.push_back({(static_cast<long long>(a) << 32) | static_cast<unsigned>(b), 0});
+    }
+  std::sort(keys.begin(), keys.end());
+  std::vector<EdgeUse> out;
+  for (size_t k = 0; k < keys.size();) {
+    size_t e = k;
+    while (e < keys.size() && keys[e].first == keys[k].first) ++e;
+    out.push_back({static_cast<int>(keys[k].first >> 32),
+                   static_cast<int>(keys[k].first & 0xffffffffLL), static_cast<int>(e - k)});
+    k = e;
+  }
+  return out;
+}
+
+std::vector<std::vector<int>> boundary_loops(const Eigen::MatrixXi& F, int n) {
+  // Directed boundary half-edges a->b (face order) whose edge is used by exactly one face.
+  std::map<std::pair<int, int>, int> count;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      int a = F(f, c), b = F(f, (c + 1) % 3);
+      if (a == b || a < 0 || b < 0 || a >= n || b >= n) continue;
+      ++count[{std::min(a, b), std::max(a, b)}];
+    }
+  std::vector<std::vector<int>> next(n);  // outgoing boundary half-edges per vertex
+  for (int f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      int a = F(f, c), b = F(f, (c + 1) % 3);
+      if (a == b || a < 0 || b < 0 || a >= n || b >= n) continue;
+      if (count[{std::min(a, b), std::max(a, b)}] == 1) next[a].push_back(b);
+    }
+  for (auto& l : next) std::sort(l.begin(), l.end());
+  std::vector<std::vector<int>> loops;
+  for (int start = 0; start < n; ++start) {
+    while (!next[start].empty()) {
+      std::vector<int> loop{start};
+      int v = start;
+      while (!next[v].empty()) {
+        const int w = next[v].front();
+        next[v].erase(next[v].begin());
+        if (w == start) break;
+        loop.push_back(w);
+        v = w;
+      }
+      loops.push_back(std::move(loop));
+    }
+  }
+  return loops;
+}
+
+}  // namespace mm

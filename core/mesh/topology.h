@@ -1,0 +1,41 @@
+// Topology queries on a triangle mesh (see mesh/mesh.h for conventions):
+// vertex adjacency, k-ring neighbourhoods, connected components, boundary loops.
+// All outputs are sorted / ordered deterministically (by vertex index), never in hash order.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace mm {
+
+// For each vertex, its neighbours (vertices sharing an edge), sorted ascending, no duplicates.
+// F: #F by 3; n: number of vertices (isolated vertices get an empty list).
+std::vector<std::vector<int>> vertex_adjacency(const Eigen::MatrixXi& F, int n);
+
+// Vertices within k edges of `seed` (k = 0 gives {seed}), sorted ascending.
+std::vector<int> k_ring(const std::vector<std::vector<int>>& adjacency, int seed, int k);
+
+// Vertices within k edges of any of `seeds`, sorted ascending.
+std::vector<int> k_ring(const std::vector<std::vector<int>>& adjacency,
+                        const std::vector<int>& seeds, int k);
+
+// Connected components through shared edges. Returns the component id of every vertex
+// (0-based, numbered in order of their smallest vertex; isolated vertices get their own id)
+// and sets *count to the number of components.
+Eigen::VectorXi vertex_components(const Eigen::MatrixXi& F, int n, int* count);
+
+// Boundary loops: edges used by exactly one face, chained into closed loops of vertex
+// indices following the face orientation. Loops are ordered by their smallest vertex, and
+// each loop starts at its smallest vertex. Boundary edges that do not close into a loop
+// (non-manifold boundaries) end their chain where it cannot be continued.
+std::vector<std::vector<int>> boundary_loops(const Eigen::MatrixXi& F, int n);
+
+// Undirected edges (i < j) with the number of faces using each, sorted by (i, j).
+struct EdgeUse {
+  int i, j;    // endpoints, i < j
+  int faces;   // number of faces containing this edge
+};
+std::vector<EdgeUse> edge_uses(const Eigen::MatrixXi& F);
+
+}  // namespace mm

@@ -1,0 +1,137 @@
+#include "operators/operators.h"
+
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+namespace mm {
+
+namespace {
+
+Eigen::Vector3d row3(const Eigen::MatrixXd& V, int i) { return V.row(i).transpose(); }
+
+}  // namespace
+
+SparseMatrix cotan_stiffness(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  const int n = static_cast<int>(V.rows());
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(F.rows() * 12);
+  for (int f = 0; f < F.rows(); ++f) {
+    const int idx[3] = {F(f, 0), F(f, 1), F(f, 2)};
+    const Eigen::Vector3d p[3] = {row3(V, idx[0]), row3(V, idx[1]), row3(V, idx[2])};
+    const double dbl_area = (p[1] - p[0]).cross(p[2] - p[0]).norm();
+    if (!(dbl_area > 0) || !std::isfinite(dbl_area)) continue;
+    for (int c = 0; c < 3; ++c) {
+      // Angle at corner c is opposite the edge (c+1, c+2): cot = (u·v) / |u×v|.
+      const int i = idx[(c + 1) % 3], j = idx[(c + 2) % 3];
+      const Eigen::Vector3d u = p[(c + 1) % 3] - p[c], v = p[(c + 2) % 3] - p[c];
+      const double half_cot = 0.5 * u.dot(v) / dbl_area;
+      t.emplace_back(i, j, -half_cot);
+      t.emplace_back(j, i, -half_cot);
+      t.emplace_back(i, i, half_cot);
+      t.emplace_back(j, j, half_cot);
+    }
+  }
+  SparseMatrix W(n, n);
+  W.setFromTriplets(t.begin(), t.end());
+  return W;
+}
+
+Eigen::VectorXd mass_diagonal(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, MassType type) {
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(V.rows());
+  for (int f = 0; f < F.rows(); ++f) {
+    const int idx[3] = {F(f, 0), F(f, 1), F(f, 2)};
+    const Eigen::Vector3d p[3] = {row3(V, idx[0]), row3(V, idx[1]), row3(V, idx[2])};
+    const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+    if (!(area > 0) || !std::isfinite(area)) continue;
+    if (type == MassType::Barycentric) {
+      for (int c = 0; c < 3; ++c) a[idx[c]] += area / 3.0;
+      continue;
+    }
+    // Mixed Voronoi area (Meyer, Desbrun, Schröder, Barr 2003, Fig. 4).
+    double dots[3];
+    for (int c = 0; c < 3; ++c)
+      dots[c] = (p[(c + 1) % 3] - p[c]).dot(p[(c + 2) % 3] - p[c]);
+    const int obtuse = dots[0] < 0 ? 0 : dots[1] < 0 ? 1 : dots[2] < 0 ? 2 : -1;
+    if (obtuse >= 0) {
+      for (int c = 0; c < 3; ++c) a[idx[c]] += (c == obtuse ? 0.5 : 0.25) * area;
+      continue;
+    }
+    for (int c = 0; c < 3; ++c) {
+      // Edge (c, c+1) has length² l2 and opposite angle at c+2 with cot = dots / (2·area).
+      const int o = (c + 2) % 3;
+      const double cot_o = dots[o] / (2.0 * area);
+      const double l2 = (p[(c + 1) % 3] - p[c]).squaredNorm();
+      const double contrib = l2 * cot_o / 8.0;
+      a[idx[c]] += contrib;
+      a[idx[(c + 1) % 3]] += contrib;
+    }
+  }
+  return a;
+}
+
+SparseMatrix mass_matrix(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, MassType type) {
+  const Eigen::VectorXd a = mass_diagonal(V, F, type);
+  SparseMatrix A(a.size(), a.size());
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(a.size());
+  for (int i = 0; i < a.size(); ++i) t.emplace_back(i, i, a[i]);
+  A.setFromTriplets(t.begin(), t.end());
+  return A;
+}
+
+SparseMatrix uniform_laplacian(const Eigen::MatrixXi& F, int n) {
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(F.rows() * 6);
+  for (int f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      const int i = F(f, c), j = F(f, (c + 1) % 3);
+      if (i == j) continue;
+      t.emplace_back(i, j, 1.0);
+      t.emplace_back(j, i, 1.0);
+    }
+  SparseMatrix adj(n, n);
+  adj.setFromTriplets(t.begin(), t.end());
+  // Edges shared by two faces were added twice: keep only the pattern.
+  for (int k = 0; k < adj.outerSize(); ++k)
+    for (SparseMatrix::InnerIterator it(adj, k); it; ++it) it.valueRef() = 1.0;
+  SparseMatrix L = -adj;
+  Eigen::VectorXd deg = adj * Eigen::VectorXd::Ones(n);
+  for (int i = 0; i < n; ++i) L.coeffRef(i, i) += deg[i];
+  L.makeCompressed();
+  return L;
+}
+
+Eigen::MatrixXd face_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(F.rows(), 3);
+  for (int f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d n = (row3(V, F(f, 1)) - row3(V, F(f, 0))).cross(row3(V, F(f, 2)) - row3(V, F(f, 0)));
+    const double len = n.norm();
+    if (len > 0 && std::isfinite(len)) N.row(f) = (n / len).transpose();
+  }
+  return N;
+}
+
+Eigen::MatrixXd vertex_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(V.rows(), 3);
+  for (int f = 0; f < F.rows(); ++f) {
+    // Unnormalised cross product = 2·area·normal: area weighting for free.
+    const Eigen::Vector3d n = (row3(V, F(f, 1)) - row3(V, F(f, 0))).cross(row3(V, F(f, 2)) - row3(V, F(f, 0)));
+    if (!n.allFinite()) continue;
+    for (int c = 0; c < 3; ++c) N.row(F(f, c)) += n.transpose();
+  }
+  for (int v = 0; v < N.rows(); ++v) {
+    const double len = N.row(v).norm();
+    if (len > 0) N.row(v) /= len;
+  }
+  return N;
+}
+
+Eigen::VectorXd face_areas(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  Eigen::VectorXd a(F.rows());
+  for (int f = 0; f < F.rows(); ++f)
+    a[f] = 0.5 * (row3(V, F(f, 1)) - row3(V, F(f, 0))).cross(row3(V, F(f, 2)) - row3(V, F(f, 0))).norm();
+  return a;
+}
+
+}  // namespace mm

@@ -1,0 +1,1 @@
+list(APPEND MM_CORE_SOURCES core/spectral/spectral_basis.cpp)

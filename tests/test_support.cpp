@@ -1,0 +1,69 @@
+#include "test_support.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace mm::test {
+
+namespace {
+bool g_update_golden = false;
+}
+
+void set_update_golden(bool on) { g_update_golden = on; }
+bool update_golden() { return g_update_golden; }
+
+std::string data_path(const std::string& relative) {
+  return std::string(MM_SOURCE_DIR) + "/data/" + relative;
+}
+
+std::string tests_path(const std::string& relative) {
+  return std::string(MM_SOURCE_DIR) + "/tests/" + relative;
+}
+
+std::string scratch_path(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::current_path() / "test-scratch";
+  std::filesystem::create_directories(dir);
+  return (dir / name).string();
+}
+
+void expect_golden(const std::string& name, const Eigen::MatrixXd& values, double tolerance) {
+  const std::string path = tests_path("golden/" + name + ".json");
+  if (g_update_golden) {
+    nlohmann::json j;
+    j["tolerance"] = tolerance;
+    j["rows"] = values.rows();
+    j["cols"] = values.cols();
+    std::vector<double> data;
+    for (int r = 0; r < values.rows(); ++r)
+      for (int c = 0; c < values.cols(); ++c) data.push_back(values(r, c));
+    j["data"] = data;
+    std::ofstream(path) << j.dump(1) << "\n";
+    return;
+  }
+  std::ifstream in(path);
+  ASSERT_TRUE(in.good()) << "missing golden file " << path << " (run with --update-golden)";
+  nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  ASSERT_FALSE(j.is_discarded()) << "golden file " << path << " is not valid JSON";
+  const double tol = j.value("tolerance", tolerance);
+  ASSERT_EQ(j["rows"].get<long>(), values.rows()) << name;
+  ASSERT_EQ(j["cols"].get<long>(), values.cols()) << name;
+  const auto data = j["data"].get<std::vector<double>>();
+  double worst = 0;
+  long worst_at = -1;
+  for (int r = 0; r < values.rows(); ++r)
+    for (int c = 0; c < values.cols(); ++c) {
+      const double d = std::abs(values(r, c) - data[r * values.cols() + c]);
+      if (!(d <= worst)) {
+        worst = d;
+        worst_at = r * values.cols() + c;
+      }
+    }
+  EXPECT_LE(worst, tol) << "golden " << name << ": largest difference " << worst << " at flat index "
+                        << worst_at << " (tolerance " << tol << ")";
+}
+
+}  // namespace mm::test

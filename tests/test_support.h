@@ -1,0 +1,26 @@
+// Shared helpers for the GoogleTest suite: data paths, mesh loading, golden files.
+#pragma once
+
+#include <string>
+
+#include <Eigen/Core>
+
+namespace mm::test {
+
+// Absolute path of a file under the repository's data/ folder (works natively and in wasm
+// under NODERAWFS, where the real file system is visible).
+std::string data_path(const std::string& relative);
+// Absolute path under tests/ (e.g. "golden/foo.json", "bad/empty.obj").
+std::string tests_path(const std::string& relative);
+// A scratch directory under the build tree, created on first use.
+std::string scratch_path(const std::string& name);
+
+// True when the binary was started with --update-golden.
+bool update_golden();
+
+// Compares `values` with tests/golden/<name>.json: same shape, max |difference| ≤ the
+// tolerance stored in the file. With --update-golden, writes the file instead (storing
+// `tolerance`) and passes. The JSON holds {"tolerance", "rows", "cols", "data": row-major}.
+void expect_golden(const std::string& name, const Eigen::MatrixXd& values, double tolerance);
+
+}  // namespace mm::test
