@@ -1,0 +1,78 @@
+// Foundation stages: load, weld, operator assembly, factorization, eigs k=20 / k=100 on
+// three meshes of increasing size. Peer figures: PEERS.md (libigl v2.6 / Spectra + LDLT,
+// same machine kind, g++ -O3); they were measured on meshes of similar, not equal, size.
+#include <cstdio>
+#include <filesystem>
+
+#include "bench.h"
+#include "io/asset.h"
+#include "linalg/spd_solver.h"
+#include "mesh/weld.h"
+#include "operators/operators.h"
+#include "spectral/spectral_basis.h"
+
+namespace mm::bench {
+namespace {
+
+struct MeshCase {
+  std::string repo, shared;  // data paths
+  std::string peer_column;   // PEERS.md column closest in size
+  std::string assembly_peer, eigs20_peer, eigs100_peer;
+};
+
+void foundation_suite(Context& ctx) {
+  const std::vector<MeshCase> cases = {
+      {"edit/camelhead.ply", "edit/camelhead.off", "10.0k", "igl 8 ms", "Spectra+LDLT 80 ms", "Spectra+LDLT 692 ms"},
+      {"pose/horse0.ply", "pose/tosca/horse0.off", "25.9k", "igl 27 ms", "Spectra+LDLT 298 ms", "Spectra+LDLT 2.89 s"},
+      {"", "pose/tosca/michael3.off", "50.0k", "igl 50 ms", "Spectra+LDLT 1.56 s", "Spectra+LDLT 8.88 s"},
+  };
+  for (const auto& c : cases) {
+    const std::string path = ctx.find_data(c.repo, c.shared);
+    if (path.empty()) {
+      std::fprintf(stderr, "  skipping %s (not in data/ and ../shared/data is absent)\n", c.shared.c_str());
+      continue;
+    }
+    const std::string name = std::filesystem::path(path).stem().string();
+    io::LoadResult lr;
+    const double t_load = ctx.time_ms([&] { lr = io::load_asset(path); }, 3);
+    if (!lr.status.ok()) {
+      std::fprintf(stderr, "  %s: %s\n", path.c_str(), lr.status.message.c_str());
+      continue;
+    }
+    const Mesh m = lr.asset.mesh();
+    const int n = m.num_vertices();
+    const std::string peer_note = "peer column " + c.peer_column + " V";
+    ctx.add({"foundation", name, n, "load", t_load, "", std::filesystem::path(path).extension().string()});
+    WeldResult w;
+    ctx.add({"foundation", name, n, "weld",
+             ctx.time_ms([&] { w = weld_vertices(lr.asset.V_raw, lr.asset.F_raw); }, 5), "", ""});
+    SparseMatrix W;
+    Eigen::VectorXd a;
+    ctx.add({"foundation", name, n, "cotan + Voronoi mass",
+             ctx.time_ms([&] { W = cotan_stiffness(m.V, m.F); a = mass_diagonal(m.V, m.F); }, 5), c.assembly_peer,
+             peer_note});
+    SpdSolver solver;
+    Status fs;
+    const SparseMatrix Msys = W + SparseMatrix(a.asDiagonal()) * 1e-3;
+    ctx.add({"foundation", name, n, "LDLT factor (W + 1e-3 A)", ctx.time_ms([&] { fs = solver.factor(Msys); }, 3), "",
+             fs.ok() ? "" : fs.message});
+    Eigen::MatrixXd X;
+    const Eigen::MatrixXd B = m.V;
+    ctx.add({"foundation", name, n, "solve, 3 RHS", ctx.time_ms([&] { (void)solver.solve(B, &X); }, 5), "", ""});
+    for (int k : {20, 100}) {
+      if (ctx.quick && k == 100) continue;
+      SpectralBasisOptions opt;
+      opt.k = k;
+      SpectralBasis b;
+      const double t = ctx.time_ms([&] { b = spectral_basis(W, a, opt); }, k == 20 ? 3 : 1);
+      ctx.add({"foundation", name, n, "eigs k=" + std::to_string(k), t, k == 20 ? c.eigs20_peer : c.eigs100_peer,
+               b.status.ok() ? std::to_string(b.operations) + " solves" : b.status.message});
+    }
+  }
+}
+
+}  // namespace
+
+MM_BENCH(foundation, foundation_suite);
+
+}  // namespace mm::bench

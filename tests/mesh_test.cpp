@@ -1,0 +1,267 @@
+// Validation, topology and welding: each defect class on a tiny hand-made mesh, then real
+// meshes from data/.
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "io/asset.h"
+#include "mesh/topology.h"
+#include "mesh/validate.h"
+#include "mesh/weld.h"
+#include "test_meshes.h"
+#include "test_support.h"
+
+namespace mm {
+
+namespace {
+
+// Two triangles sharing edge 1-2, a unit square split along its diagonal:
+//   3---2
+//   | / |
+//   0---1
+Eigen::MatrixXd square_V() {
+  Eigen::MatrixXd V(4, 3);
+  V << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
+  return V;
+}
+Eigen::MatrixXi square_F() {
+  Eigen::MatrixXi F(2, 3);
+  F << 0, 1, 2, 0, 2, 3;
+  return F;
+}
+
+const DefectReport* find_defect(const MeshReport& r, MeshDefect d) {
+  for (const auto& x : r.defects)
+    if (x.defect == d) return &x;
+  return nullptr;
+}
+
+}  // namespace
+
+TEST(Validate, CleanSquareHasNoDefectsAndOneBoundaryLoop) {
+  const MeshReport r = validate_mesh(square_V(), square_F());
+  EXPECT_TRUE(r.defects.empty()) << r.to_text();
+  EXPECT_EQ(r.num_components, 1);
+  ASSERT_EQ(r.boundary_loops.size(), 1u);
+  EXPECT_EQ(r.boundary_loops[0], (std::vector<int>{0, 1, 2, 3}));
+  EXPECT_EQ(r.euler_characteristic, 1);
+  EXPECT_NEAR(r.bbox_diagonal, std::sqrt(2.0), 1e-15);
+}
+
+TEST(Validate, EmptyMesh) {
+  const MeshReport r = validate_mesh(Eigen::MatrixXd(0, 3), Eigen::MatrixXi(0, 3));
+  ASSERT_NE(find_defect(r, MeshDefect::Empty), nullptr);
+  const Status s = r.status(fatal_defects());
+  EXPECT_EQ(s.code, StatusCode::InvalidMesh);
+  EXPECT_NE(s.message.find("empty"), std::string::npos);
+}
+
+TEST(Validate, NonFiniteCoordinates) {
+  Eigen::MatrixXd V = square_V();
+  V(2, 1) = std::numeric_limits<double>::quiet_NaN();
+  V(3, 0) = std::numeric_limits<double>::infinity();
+  const MeshReport r = validate_mesh(V, square_F());
+  const auto* d = find_defect(r, MeshDefect::NonFiniteCoordinate);
+  ASSERT_NE(d, nullptr);
+  EXPECT_EQ(d->count, 2);
+  EXPECT_EQ(d->example, "vertex 2");
+  EXPECT_EQ(r.status(fatal_defects()).code, StatusCode::InvalidMesh);
+  EXPECT_TRUE(std::isfinite(r.bbox_diagonal));
+}
+
+TEST(Validate, OutOfRangeIndices) {
+  Eigen::MatrixXi F = square_F();
+  F(1, 2) = 7;
+  const MeshReport r = validate_mesh(square_V(), F);
+  const auto* d = find_defect(r, MeshDefect::IndexOutOfRange);
+  ASSERT_NE(d, nullptr);
+  EXPECT_EQ(d->count, 1);
+  EXPECT_NE(d->example.find("face 1"), std::string::npos);
+  EXPECT_NE(r.status(fatal_defects()).message.find("out-of-range"), std::string::npos);
+}
+
+TEST(Validate, DegenerateFacesRepeatedIndexAndZeroArea) {
+  Eigen::MatrixXd V(5, 3);
+  V << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 2, 0, 0;  // vertex 4 collinear with 0 and 1
+  Eigen::MatrixXi F(4, 3);
+  F << 0, 1, 2, 0, 2, 3, 0, 0, 3, 0, 1, 4;
+  const MeshReport r = validate_mesh(V, F);
+  const auto* d = find_defect(r, MeshDefect::DegenerateFace);
+  ASSERT_NE(d, nullptr);
+  EXPECT_EQ(d->count, 2);
+  EXPECT_NE(d->example.find("face 2"), std::string::npos);
+  EXPECT_TRUE(r.status(fatal_defects()).ok());
+  EXPECT_FALSE(r.status(manifold_defects()).ok());
+}
+
+TEST(Validate, DuplicateFacesInAnyOrder) {
+  Eigen::MatrixXi F(3, 3);
+  F << 0, 1, 2, 0, 2, 3, 2, 0, 1;
+  const MeshReport r = validate_mesh(square_V(), F);
+  const auto* d = find_defect(r, MeshDefect::DuplicateFace);
+  ASSERT_NE(d, nullptr);
+  EXPECT_EQ(d->count, 1);
+  EXPECT_NE(d->example.find("repeats face 0"), std::string::npos);
+}
+
+TEST(Validate, NonManifoldEdge) {
+  // Three triangles on edge 0-1 (a "book" with three pages).
+  Eigen::MatrixXd V(5, 3);
+  V << 0, 0, 0, 1, 0, 0, 0.5, 1, 0, 0.5, -1, 0, 0.5, 0, 1;
+  Eigen::MatrixXi F(3, 3);
+  F << 0, 1, 2, 1, 0, 3, 0, 1, 4;
+  const MeshReport r = validate_mesh(V, F);
+  const auto* d = find_defect(r, MeshDefect::NonManifoldEdge);
+  ASSERT_NE(d, nullptr);
+  EXPECT_EQ(d->count, 1);
+  EXPECT_EQ(d->example, "edge 0-1 in 3 faces");
+  EXPECT_NE(r.status(manifold_defects()).message.find("1 non-manifold edges"), std::string::npos);
+}
+
+TEST(Validate, NonManifoldVertexBowTie) {
+  // Two triangles touching only at vertex 0.
+  Eigen::MatrixXd V(5, 3);
+  V << 0, 0, 0, 1, 0, 0, 1, 1, 0, -1, 0, 0, -1, -1, 0;
+  Eigen::MatrixXi F(2, 3);
+  F << 0, 1, 2, 0, 3, 4;
+  const MeshReport r = validate_mesh(V, F);
+  const auto* d = find_defect(r, MeshDefect::NonManifoldVertex);
+  ASSERT_NE(d, nullptr);
+  EXPECT_EQ(d->count, 1);
+  EXPECT_EQ(d->example, "vertex 0 joins 2 fans");
+  EXPECT_EQ(r.num_components, 1);
+}
+
+TEST(Validate, UnreferencedVertex) {
+  Eigen::MatrixXd V(5, 3);
+  V.topRows(4) = square_V();
+  V.row(4) << 5, 5, 5;
+  const MeshReport r = validate_mesh(V, square_F());
+  const auto* d = find_defect(r, MeshDefect::UnreferencedVertex);
+  ASSERT_NE(d, nullptr);
+  EXPECT_EQ(d->example, "vertex 4");
+  EXPECT_EQ(r.num_components, 1);  // the lone vertex is not a surface component
+}
+
+TEST(Validate, InconsistentOrientation) {
+  // Face 1 reversed to (0, 3, 2): both faces now contain the directed edge 2->0.
+  Eigen::MatrixXi F = square_F();
+  F.row(1) << 0, 3, 2;
+  const MeshReport r = validate_mesh(square_V(), F);
+  const auto* d = find_defect(r, MeshDefect::InconsistentOrientation);
+  ASSERT_NE(d, nullptr);
+  EXPECT_EQ(d->count, 1);
+  EXPECT_EQ(d->example, "edge 2->0 appears twice");
+}
+
+TEST(Topology, KRingGrowsByRings) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  test::grid(5, 5, &V, &F);
+  const auto adj = vertex_adjacency(F, 25);
+  EXPECT_EQ(k_ring(adj, 12, 0), std::vector<int>{12});
+  EXPECT_EQ(k_ring(adj, 12, 1).size(), 7u);  // centre + 6 neighbours (diagonal split grid)
+  EXPECT_EQ(k_ring(adj, 12, 2).size(), 19u);
+  EXPECT_EQ(k_ring(adj, 12, 10).size(), 25u);
+}
+
+TEST(Topology, ComponentsOfTwoSpheres) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  test::icosphere(1, &V, &F);
+  Eigen::MatrixXd V2(V.rows() * 2, 3);
+  V2 << V, V.rowwise() + Eigen::RowVector3d(3, 0, 0);
+  Eigen::MatrixXi F2(F.rows() * 2, 3);
+  F2 << F, F.array() + static_cast<int>(V.rows());
+  int count = 0;
+  const Eigen::VectorXi comp = vertex_components(F2, static_cast<int>(V2.rows()), &count);
+  EXPECT_EQ(count, 2);
+  EXPECT_EQ(comp[0], 0);
+  EXPECT_EQ(comp[V.rows()], 1);
+  const MeshReport r = validate_mesh(V2, F2);
+  EXPECT_EQ(r.num_components, 2);
+  EXPECT_TRUE(r.closed());
+  EXPECT_EQ(r.euler_characteristic, 4);
+}
+
+TEST(Weld, MergesSeamSplitVerticesAndMapsBack) {
+  // The square with vertices 0 and 2 duplicated for face 1 (as a glTF UV seam would).
+  Eigen::MatrixXd V(6, 3);
+  V << square_V(), 0, 0, 0, 1, 1, 0;
+  Eigen::MatrixXi F(2, 3);
+  F << 0, 1, 2, 4, 5, 3;
+  const WeldResult w = weld_vertices(V, F);
+  EXPECT_EQ(w.V.rows(), 4);
+  EXPECT_EQ(w.F.rows(), 2);
+  EXPECT_EQ(w.to_welded[4], 0);
+  EXPECT_EQ(w.to_welded[5], 2);
+  EXPECT_TRUE(validate_mesh(w.V, w.F).defects.empty());
+  EXPECT_EQ(validate_mesh(w.V, w.F).boundary_loops.size(), 1u);
+  const Eigen::MatrixXd back = unweld(w.V, w.to_welded);
+  EXPECT_EQ((back - V).cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(Weld, AlreadyWeldedMeshIsUnchangedAndNaNIsNotMerged) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  test::icosphere(2, &V, &F);
+  const WeldResult w = weld_vertices(V, F);
+  EXPECT_EQ(w.V, V);
+  EXPECT_EQ(w.F, F);
+  Eigen::MatrixXd Vn = square_V();
+  Vn(1, 0) = std::numeric_limits<double>::quiet_NaN();
+  Vn(3, 0) = std::numeric_limits<double>::quiet_NaN();
+  const WeldResult wn = weld_vertices(Vn, square_F());
+  EXPECT_EQ(wn.V.rows(), 4);
+}
+
+TEST(TopologyRealMesh, OpenMeshesHaveTheirDocumentedBoundaryLoops) {
+  struct Case {
+    const char* file;
+    std::vector<size_t> loop_lengths;
+  };
+  // Loop lengths from data/MANIFEST.md (cylinder: 2 loops × 40, hand wrist: 16).
+  for (const Case& c : {Case{"edit/cylinder_coarse.ply", {40, 40}}, Case{"edit/hand_lowres.ply", {16}},
+                        Case{"edit/camelhead.ply", {56}}, Case{"edit/mannequin.ply", {60}}}) {
+    const io::LoadResult lr = io::load_asset(test::data_path(c.file));
+    ASSERT_TRUE(lr.status.ok()) << lr.status.message;
+    const Mesh m = lr.asset.mesh();
+    const MeshReport r = validate_mesh(m.V, m.F);
+    EXPECT_TRUE(r.defects.empty()) << c.file << "\n" << r.to_text();
+    std::vector<size_t> lengths;
+    for (const auto& l : r.boundary_loops) lengths.push_back(l.size());
+    EXPECT_EQ(lengths, c.loop_lengths) << c.file;
+    EXPECT_EQ(r.num_components, 1) << c.file;
+  }
+}
+
+TEST(TopologyRealMesh, CamelReportsItsKnownDefects) {
+  const io::LoadResult lr = io::load_asset(test::data_path("pose/camel_ref.ply"));
+  ASSERT_TRUE(lr.status.ok()) << lr.status.message;
+  const MeshReport r = validate_mesh(lr.asset.V_raw, lr.asset.F_raw);
+  // MANIFEST.md: 26 non-manifold edges, 5 boundary edges, 51 inconsistently oriented half-edges.
+  EXPECT_EQ(r.count(MeshDefect::NonManifoldEdge), 26);
+  EXPECT_GT(r.count(MeshDefect::InconsistentOrientation), 0);
+  const Status s = r.status(manifold_defects());
+  EXPECT_EQ(s.code, StatusCode::InvalidMesh);
+  EXPECT_NE(s.message.find("26 non-manifold edges"), std::string::npos) << s.message;
+}
+
+TEST(TopologyRealMesh, ClosedMeshesAreWatertightWithExpectedGenus) {
+  struct Case {
+    const char* file;
+    int euler;
+  };
+  for (const Case& c : {Case{"pose/cat-reference.ply", 2}, Case{"edit/skull.ply", -2},
+                        Case{"pose/horse0.ply", 2}, Case{"edit/armadillo.ply", 2}}) {
+    const io::LoadResult lr = io::load_asset(test::data_path(c.file));
+    ASSERT_TRUE(lr.status.ok()) << lr.status.message;
+    const Mesh m = lr.asset.mesh();
+    const MeshReport r = validate_mesh(m.V, m.F);
+    EXPECT_TRUE(r.closed()) << c.file;
+    EXPECT_EQ(r.euler_characteristic, c.euler) << c.file;
+    EXPECT_TRUE(r.status(manifold_defects()).ok()) << c.file << ": " << r.to_text();
+  }
+}
+
+}  // namespace mm

@@ -1,0 +1,104 @@
+// Operators on analytic and real meshes: the sphere's area, W's null space and symmetry,
+// the mass lumping's partition of area, normals.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "io/asset.h"
+#include "operators/operators.h"
+#include "test_meshes.h"
+#include "test_support.h"
+
+namespace mm {
+
+namespace {
+double asymmetry(const SparseMatrix& W) { return (SparseMatrix(W.transpose()) - W).norm(); }
+}  // namespace
+
+TEST(MassMatrix, UnitSphereAreaIsFourPi) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  test::icosphere(5, &V, &F);
+  ASSERT_GE(V.rows(), 10000);
+  for (MassType t : {MassType::Voronoi, MassType::Barycentric}) {
+    const double area = mass_diagonal(V, F, t).sum();
+    EXPECT_NEAR(area, 4 * M_PI, 0.005 * 4 * M_PI);
+    EXPECT_NEAR(area, face_areas(V, F).sum(), 1e-9);  // lumping partitions the surface area
+  }
+  EXPECT_GT(mass_diagonal(V, F).minCoeff(), 0.0);
+}
+
+TEST(MassMatrix, ObtuseTrianglesGetNoNegativeArea) {
+  Eigen::MatrixXd V(3, 3);
+  V << 0, 0, 0, 10, 0, 0, 5, 0.1, 0;  // very obtuse at vertex 2
+  Eigen::MatrixXi F(1, 3);
+  F << 0, 1, 2;
+  const Eigen::VectorXd a = mass_diagonal(V, F);
+  EXPECT_GT(a.minCoeff(), 0.0);
+  EXPECT_NEAR(a.sum(), 0.5, 1e-12);
+  EXPECT_NEAR(a[2], 0.25, 1e-12);  // half the area goes to the obtuse corner
+}
+
+TEST(CotanStiffness, AnnihilatesConstantsAndIsSymmetricPsd) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  test::icosphere(3, &V, &F);
+  const SparseMatrix W = cotan_stiffness(V, F);
+  EXPECT_LT((W * Eigen::VectorXd::Ones(V.rows())).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT(asymmetry(W), 1e-12);
+  // Dirichlet energy of the coordinates: xᵀWx = ½ Σ w (xi - xj)² ≥ 0.
+  for (int c = 0; c < 3; ++c) EXPECT_GT(V.col(c).dot(W * V.col(c)), 0.0);
+  // Diagonal positive, off-diagonals of a Delaunay-ish sphere negative.
+  for (int i = 0; i < W.rows(); ++i) EXPECT_GT(W.coeff(i, i), 0.0);
+}
+
+TEST(CotanStiffness, RealMeshesConstantsAndSymmetry) {
+  for (const char* file : {"pose/cat-reference.ply", "edit/hand_lowres.ply", "anim/CesiumMan/CesiumMan.glb"}) {
+    const io::LoadResult lr = io::load_asset(test::data_path(file));
+    ASSERT_TRUE(lr.status.ok()) << lr.status.message;
+    const Mesh m = lr.asset.mesh();
+    const SparseMatrix W = cotan_stiffness(m.V, m.F);
+    const double scale = W.diagonal().cwiseAbs().maxCoeff();
+    EXPECT_LT((W * Eigen::VectorXd::Ones(m.V.rows())).cwiseAbs().maxCoeff(), 1e-10 * scale) << file;
+    EXPECT_LT(asymmetry(W), 1e-10 * scale) << file;
+    EXPECT_TRUE(mass_diagonal(m.V, m.F).allFinite()) << file;
+  }
+}
+
+TEST(CotanStiffness, LinearFunctionsAreHarmonicInTheInteriorOfAPlane) {
+  // On a flat grid, the cotan Laplacian of a linear function vanishes at interior vertices.
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  test::grid(8, 6, &V, &F);
+  const SparseMatrix W = cotan_stiffness(V, F);
+  const Eigen::VectorXd f = 2.0 * V.col(0) - 3.0 * V.col(1);
+  const Eigen::VectorXd Wf = W * f;
+  for (int j = 1; j < 5; ++j)
+    for (int i = 1; i < 7; ++i) EXPECT_NEAR(Wf[j * 8 + i], 0.0, 1e-12);
+}
+
+TEST(UniformLaplacian, DegreesOnTheDiagonal) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  test::icosphere(1, &V, &F);
+  const SparseMatrix L = uniform_laplacian(F, static_cast<int>(V.rows()));
+  EXPECT_LT((L * Eigen::VectorXd::Ones(V.rows())).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_EQ(L.coeff(0, 0), 5.0);  // icosahedron corners keep valence 5
+  EXPECT_EQ(L.coeff(12, 12), 6.0);
+  EXPECT_LT(asymmetry(L), 1e-15);
+}
+
+TEST(Normals, SphereNormalsPointOutward) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  test::icosphere(3, &V, &F);
+  const Eigen::MatrixXd N = vertex_normals(V, F);
+  for (int i = 0; i < V.rows(); ++i) {
+    EXPECT_NEAR(N.row(i).norm(), 1.0, 1e-12);
+    EXPECT_GT(N.row(i).dot(V.row(i)), 0.999);
+  }
+  const Eigen::MatrixXd FN = face_normals(V, F);
+  EXPECT_GT((FN.array() * FN.array()).rowwise().sum().minCoeff(), 0.999);
+}
+
+}  // namespace mm

@@ -1,0 +1,342 @@
+// Bindings of the mesh, io, operators and spectral modules for the page's worker
+// (web/src/ops/mesh.js) and the node API tests (tests/js/). Data conversion only: every
+// number computed here comes from a core/ function.
+//
+// JS API (all calls return plain objects; a failure is {ok:false, code, message}, see
+// convert.h status_object; the JS wrapper in web/src/ops/mesh.js throws an Error carrying code):
+//
+//   loadAsset(bytes: Uint8Array, name: string, files?: {[uri]: Uint8Array}, options?)
+//     → {ok, asset: number, name, format, warnings: string[], primitives: [...],
+//        positions: Float32Array (#R·3, raw layout, world space), indices: Uint32Array (#T·3),
+//        normals: Float32Array (#R·3, smooth normals of the welded surface, raw layout),
+//        toWelded: Uint32Array (#R), weldedPositions: Float64Array (#W·3),
+//        weldedIndices: Uint32Array (#F·3), report: MeshReport object (of the welded mesh),
+//        text: string (the `meshmorph info` report)}
+//     `name` picks the format by extension. `files` resolves a .gltf's external buffers and
+//     images by URI (exact key first, then the URI's last path segment). `options` mirrors
+//     io::LoadOptions: {weld: {tolerance, drop_degenerate_faces}, skip_unsupported_primitives}.
+//     The asset stays in a registry until disposeAsset(asset).
+//   disposeAsset(asset: number) → boolean (false when unknown)
+//   exportAsset(asset, positions?: Float64Array|Float32Array (#W·3 welded, world space;
+//               undefined keeps the loaded geometry), format = "glb", options? {recompute_normals})
+//     → {ok, bytes: Uint8Array}
+//   saveMesh(format, positions (#V·3), indices (#F·3), colors? (#V·3 in 0..1)) → {ok, bytes}
+//   validateMesh(positions (#V·3), indices (#F·3), options? {degenerate_area_tolerance})
+//     → {ok: true, report, text}
+//   spectralBasis(positions (#V·3), indices (#F·3), options? {k, ncv, relative_shift,
+//                 tolerance, max_iterations}, progress?: (stage, fraction) => boolean)
+//     → {ok, eigenvalues: Float64Array (k, ascending), vectors: Float32Array (k·#V; basis
+//        function i occupies [i·#V, (i+1)·#V), the layout the viewer slices), iterations,
+//        operations}. Returning false from progress cancels (code "Cancelled").
+//
+// Exceptions: core reports data errors as Status; a stray C++ exception (bad_alloc on a huge
+// file, a bug) is caught here and returned as code "Internal" so the worker stays usable.
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <emscripten/bind.h>
+#include <emscripten/val.h>
+
+#include "convert.h"
+#include "io/asset.h"
+#include "mesh/validate.h"
+#include "mesh/weld.h"
+#include "operators/operators.h"
+#include "spectral/spectral_basis.h"
+
+namespace mm::wasm {
+
+using emscripten::val;
+
+namespace {
+
+// Loaded assets by id. The worker is single-threaded and owns this module instance, so a plain
+// map is enough; ids are never reused within one module instance.
+std::map<int, std::unique_ptr<io::Asset>>& asset_registry() {
+  static std::map<int, std::unique_ptr<io::Asset>> registry;
+  return registry;
+}
+int g_next_asset_id = 1;
+
+val error_object(StatusCode code, const std::string& message) {
+  return status_object(Status::error(code, message));
+}
+
+val internal_error(const std::string& what) {
+  val o = val::object();
+  o.set("ok", false);
+  o.set("code", std::string("Internal"));
+  o.set("message", "internal error: " + what);
+  return o;
+}
+
+std::optional<io::Format> parse_format(const std::string& name) {
+  return io::format_from_path("x." + name);
+}
+
+val int_array(const std::vector<int>& v) {
+  val a = val::array();
+  for (size_t i = 0; i < v.size(); ++i) a.set(i, v[i]);
+  return a;
+}
+
+val vec3(const Eigen::Vector3d& v) {
+  val a = val::array();
+  for (int i = 0; i < 3; ++i) a.set(i, v[i]);
+  return a;
+}
+
+val report_object(const MeshReport& r) {
+  val o = val::object();
+  o.set("vertices", r.num_vertices);
+  o.set("faces", r.num_faces);
+  o.set("edges", r.num_edges);
+  o.set("bboxMin", vec3(r.bbox_min));
+  o.set("bboxMax", vec3(r.bbox_max));
+  o.set("bboxDiagonal", r.bbox_diagonal);
+  o.set("components", r.num_components);
+  o.set("componentSizes", int_array(r.component_sizes));
+  std::vector<int> loop_lengths;
+  for (const auto& loop : r.boundary_loops) loop_lengths.push_back(static_cast<int>(loop.size()));
+  o.set("boundaryLoopLengths", int_array(loop_lengths));
+  o.set("eulerCharacteristic", r.euler_characteristic);
+  o.set("closed", r.closed());
+  val defects = val::array();
+  for (size_t i = 0; i < r.defects.size(); ++i) {
+    val d = val::object();
+    d.set("name", std::string(mesh_defect_name(r.defects[i].defect)));
+    d.set("count", r.defects[i].count);
+    d.set("example", r.defects[i].example);
+    defects.set(i, d);
+  }
+  o.set("defects", defects);
+  return o;
+}
+
+// The same text `meshmorph info` prints: a header about the file, then the welded mesh's
+// validation report.
+std::string asset_text(const io::Asset& a, const MeshReport& r) {
+  std::ostringstream os;
+  os << "file: " << a.source_name << " (" << io::format_name(a.format) << ")\n"
+     << "primitives: " << a.primitives.size() << "\n"
+     << "raw vertices: " << a.V_raw.rows() << " (welded to " << a.weld.V.rows() << ")\n"
+     << "raw triangles: " << a.F_raw.rows() << "\n"
+     << r.to_text();
+  for (const auto& w : a.warnings) os << "warning: " << w << "\n";
+  return os.str();
+}
+
+val primitives_array(const io::Asset& a) {
+  val out = val::array();
+  for (size_t i = 0; i < a.primitives.size(); ++i) {
+    const io::PrimitiveRef& p = a.primitives[i];
+    val o = val::object();
+    o.set("name", p.name);
+    o.set("node", p.node);
+    o.set("mesh", p.mesh);
+    o.set("primitive", p.primitive);
+    o.set("firstVertex", p.first_vertex);
+    o.set("numVertices", p.num_vertices);
+    o.set("firstFace", p.first_face);
+    o.set("numFaces", p.num_faces);
+    o.set("skinned", p.skinned);
+    out.set(i, o);
+  }
+  return out;
+}
+
+val string_array(const std::vector<std::string>& v) {
+  val a = val::array();
+  for (size_t i = 0; i < v.size(); ++i) a.set(i, v[i]);
+  return a;
+}
+
+std::string last_segment(const std::string& uri) {
+  const size_t slash = uri.find_last_of("/\\");
+  return slash == std::string::npos ? uri : uri.substr(slash + 1);
+}
+
+val load_asset_js(const val& bytes_js, const std::string& name, const val& files,
+                  const val& options) {
+  try {
+    const std::optional<io::Format> format = io::format_from_path(name);
+    if (!format)
+      return error_object(StatusCode::Unsupported,
+                          "cannot tell the format of '" + name +
+                              "': expected a .glb, .gltf, .obj, .off or .ply file");
+    const std::vector<uint8_t> bytes = to_bytes(bytes_js);
+
+    io::LoadOptions opt;
+    const val weld = options.isUndefined() || options.isNull() ? val::undefined() : options["weld"];
+    opt.weld.tolerance = get_number(weld, "tolerance", opt.weld.tolerance);
+    opt.weld.drop_degenerate_faces = get_bool(weld, "drop_degenerate_faces", opt.weld.drop_degenerate_faces);
+    opt.skip_unsupported_primitives =
+        get_bool(options, "skip_unsupported_primitives", opt.skip_unsupported_primitives);
+
+    // The resolver only looks into the object the page built from the files the user chose,
+    // so it cannot reach anything else; io::load_asset_from_memory has already refused
+    // absolute paths and "..".
+    io::FileResolver resolver;
+    if (!files.isUndefined() && !files.isNull()) {
+      resolver = [&files](const std::string& uri, std::vector<uint8_t>* out) {
+        for (const std::string& key : {uri, last_segment(uri)}) {
+          const val f = files[key];
+          if (!f.isUndefined() && !f.isNull()) {
+            *out = to_bytes(f);
+            return true;
+          }
+        }
+        return false;
+      };
+    }
+
+    io::LoadResult loaded = io::load_asset_from_memory(bytes, *format, name, resolver, opt);
+    if (!loaded.status.ok()) return status_object(loaded.status);
+
+    auto asset = std::make_unique<io::Asset>(std::move(loaded.asset));
+    const MeshReport report = validate_mesh(asset->weld.V, asset->weld.F);
+    const Eigen::MatrixXd normals =
+        unweld(vertex_normals(asset->weld.V, asset->weld.F), asset->weld.to_welded);
+
+    val o = status_object(Status::success());
+    o.set("name", asset->source_name);
+    o.set("format", std::string(io::format_name(asset->format)));
+    o.set("warnings", string_array(asset->warnings));
+    o.set("primitives", primitives_array(*asset));
+    o.set("positions", to_float32_array(asset->V_raw));
+    o.set("indices", to_uint32_array(asset->F_raw));
+    o.set("normals", to_float32_array(normals));
+    o.set("toWelded", to_uint32_array(asset->weld.to_welded));
+    o.set("weldedPositions", to_float64_array(asset->weld.V));
+    o.set("weldedIndices", to_uint32_array(asset->weld.F));
+    o.set("report", report_object(report));
+    o.set("text", asset_text(*asset, report));
+
+    const int id = g_next_asset_id++;
+    asset_registry()[id] = std::move(asset);
+    o.set("asset", id);
+    return o;
+  } catch (const std::exception& e) {
+    return internal_error(e.what());
+  } catch (...) {
+    return internal_error("unknown exception while loading");
+  }
+}
+
+bool dispose_asset_js(int id) { return asset_registry().erase(id) > 0; }
+
+val export_asset_js(int id, const val& positions, const std::string& format_name,
+                    const val& options) {
+  try {
+    const auto it = asset_registry().find(id);
+    if (it == asset_registry().end())
+      return error_object(StatusCode::InvalidArgument, "no loaded asset with id " + std::to_string(id));
+    const io::Asset& asset = *it->second;
+    const std::optional<io::Format> format = parse_format(format_name.empty() ? "glb" : format_name);
+    if (!format) return error_object(StatusCode::InvalidArgument, "unknown export format '" + format_name + "'");
+
+    Eigen::MatrixXd V = asset.weld.V;
+    if (!positions.isUndefined() && !positions.isNull()) {
+      V = to_matrix(positions);
+      if (V.rows() != asset.weld.V.rows())
+        return error_object(StatusCode::InvalidArgument,
+                            "export got " + std::to_string(V.rows()) + " positions for a mesh of " +
+                                std::to_string(asset.weld.V.rows()) + " welded vertices");
+    }
+    io::SaveOptions opt;
+    opt.recompute_normals = get_bool(options, "recompute_normals", opt.recompute_normals);
+    std::vector<uint8_t> bytes;
+    const Status s = io::save_asset_to_memory(asset, V, *format, &bytes, opt);
+    if (!s.ok()) return status_object(s);
+    val o = status_object(s);
+    o.set("bytes", to_uint8_array(bytes));
+    return o;
+  } catch (const std::exception& e) {
+    return internal_error(e.what());
+  } catch (...) {
+    return internal_error("unknown exception while exporting");
+  }
+}
+
+val save_mesh_js(const std::string& format_name, const val& positions, const val& indices,
+                 const val& colors) {
+  try {
+    const std::optional<io::Format> format = parse_format(format_name);
+    if (!format) return error_object(StatusCode::InvalidArgument, "unknown format '" + format_name + "'");
+    const Eigen::MatrixXd V = to_matrix(positions);
+    const Eigen::MatrixXi F = to_index_matrix(indices);
+    const Eigen::MatrixXd C = colors.isUndefined() || colors.isNull() ? Eigen::MatrixXd() : to_matrix(colors);
+    std::vector<uint8_t> bytes;
+    const Status s = io::save_mesh_to_memory(*format, V, F, &bytes, C);
+    if (!s.ok()) return status_object(s);
+    val o = status_object(s);
+    o.set("bytes", to_uint8_array(bytes));
+    return o;
+  } catch (const std::exception& e) {
+    return internal_error(e.what());
+  }
+}
+
+val validate_mesh_js(const val& positions, const val& indices, const val& options) {
+  try {
+    ValidateOptions opt;
+    opt.degenerate_area_tolerance =
+        get_number(options, "degenerate_area_tolerance", opt.degenerate_area_tolerance);
+    const MeshReport r = validate_mesh(to_matrix(positions), to_index_matrix(indices), opt);
+    val o = status_object(Status::success());
+    o.set("report", report_object(r));
+    o.set("text", r.to_text());
+    return o;
+  } catch (const std::exception& e) {
+    return internal_error(e.what());
+  }
+}
+
+val spectral_basis_js(const val& positions, const val& indices, const val& options,
+                      const val& progress) {
+  try {
+    const Eigen::MatrixXd V = to_matrix(positions);
+    const Eigen::MatrixXi F = to_index_matrix(indices);
+    // The eigensolver needs a usable surface: refuse NaN/out-of-range input with the
+    // validator's message rather than letting the factorization fail obscurely.
+    const Status valid = check_mesh(V, F);
+    if (!valid.ok()) return status_object(valid);
+
+    SpectralBasisOptions opt;
+    opt.k = get_int(options, "k", opt.k);
+    opt.ncv = get_int(options, "ncv", opt.ncv);
+    opt.relative_shift = get_number(options, "relative_shift", opt.relative_shift);
+    opt.tolerance = get_number(options, "tolerance", opt.tolerance);
+    opt.max_iterations = get_int(options, "max_iterations", opt.max_iterations);
+
+    const SpectralBasis basis = spectral_basis(V, F, opt, js_progress(progress));
+    if (!basis.status.ok()) return status_object(basis.status);
+    val o = status_object(basis.status);
+    o.set("eigenvalues", to_float64_array(basis.eigenvalues));
+    // #V by k column-major = k by #V row-major: one contiguous block per basis function.
+    o.set("vectors", to_float32_array(basis.vectors.transpose()));
+    o.set("iterations", basis.iterations);
+    o.set("operations", basis.operations);
+    return o;
+  } catch (const std::exception& e) {
+    return internal_error(e.what());
+  }
+}
+
+}  // namespace
+
+EMSCRIPTEN_BINDINGS(meshmorph_mesh) {
+  emscripten::function("loadAsset", &load_asset_js);
+  emscripten::function("disposeAsset", &dispose_asset_js);
+  emscripten::function("exportAsset", &export_asset_js);
+  emscripten::function("saveMesh", &save_mesh_js);
+  emscripten::function("validateMesh", &validate_mesh_js);
+  emscripten::function("spectralBasis", &spectral_basis_js);
+}
+
+}  // namespace mm::wasm
