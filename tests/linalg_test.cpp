@@ -3,6 +3,7 @@
 #include <random>
 
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 
 #include "linalg/polar.h"
 #include "linalg/spd_solver.h"

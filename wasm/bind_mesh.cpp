@@ -11,7 +11,8 @@
 //        normals: Float32Array (#R·3, smooth normals of the welded surface, raw layout),
 //        toWelded: Uint32Array (#R), weldedPositions: Float64Array (#W·3),
 //        weldedIndices: Uint32Array (#F·3), report: MeshReport object (of the welded mesh),
-//        text: string (the `meshmorph info` report)}
+//        text: string and info: object (the `meshmorph info` report and its --json form,
+//        io/info_report.h)}
 //     `name` picks the format by extension. `files` resolves a .gltf's external buffers and
 //     images by URI (exact key first, then the URI's last path segment). `options` mirrors
 //     io::LoadOptions: {weld: {tolerance, drop_degenerate_faces}, skip_unsupported_primitives}.
@@ -44,6 +45,7 @@
 
 #include "convert.h"
 #include "io/asset.h"
+#include "io/info_report.h"
 #include "mesh/validate.h"
 #include "mesh/weld.h"
 #include "operators/operators.h"
@@ -91,6 +93,22 @@ val vec3(const Eigen::Vector3d& v) {
   return a;
 }
 
+// Stable identifier of a defect for code (mesh_defect_name is the human wording).
+const char* defect_id(MeshDefect d) {
+  switch (d) {
+    case MeshDefect::Empty: return "Empty";
+    case MeshDefect::NonFiniteCoordinate: return "NonFiniteCoordinate";
+    case MeshDefect::IndexOutOfRange: return "IndexOutOfRange";
+    case MeshDefect::DegenerateFace: return "DegenerateFace";
+    case MeshDefect::DuplicateFace: return "DuplicateFace";
+    case MeshDefect::NonManifoldEdge: return "NonManifoldEdge";
+    case MeshDefect::NonManifoldVertex: return "NonManifoldVertex";
+    case MeshDefect::UnreferencedVertex: return "UnreferencedVertex";
+    case MeshDefect::InconsistentOrientation: return "InconsistentOrientation";
+  }
+  return "Unknown";
+}
+
 val report_object(const MeshReport& r) {
   val o = val::object();
   o.set("vertices", r.num_vertices);
@@ -109,6 +127,7 @@ val report_object(const MeshReport& r) {
   val defects = val::array();
   for (size_t i = 0; i < r.defects.size(); ++i) {
     val d = val::object();
+    d.set("id", std::string(defect_id(r.defects[i].defect)));
     d.set("name", std::string(mesh_defect_name(r.defects[i].defect)));
     d.set("count", r.defects[i].count);
     d.set("example", r.defects[i].example);
@@ -116,19 +135,6 @@ val report_object(const MeshReport& r) {
   }
   o.set("defects", defects);
   return o;
-}
-
-// The same text `meshmorph info` prints: a header about the file, then the welded mesh's
-// validation report.
-std::string asset_text(const io::Asset& a, const MeshReport& r) {
-  std::ostringstream os;
-  os << "file: " << a.source_name << " (" << io::format_name(a.format) << ")\n"
-     << "primitives: " << a.primitives.size() << "\n"
-     << "raw vertices: " << a.V_raw.rows() << " (welded to " << a.weld.V.rows() << ")\n"
-     << "raw triangles: " << a.F_raw.rows() << "\n"
-     << r.to_text();
-  for (const auto& w : a.warnings) os << "warning: " << w << "\n";
-  return os.str();
 }
 
 val primitives_array(const io::Asset& a) {
@@ -199,7 +205,8 @@ val load_asset_js(const val& bytes_js, const std::string& name, const val& files
     if (!loaded.status.ok()) return status_object(loaded.status);
 
     auto asset = std::make_unique<io::Asset>(std::move(loaded.asset));
-    const MeshReport report = validate_mesh(asset->weld.V, asset->weld.F);
+    // The `meshmorph info` report (text and JSON) so the page shows what the CLI prints.
+    const io::InfoReport info = io::info_report(*asset);
     const Eigen::MatrixXd normals =
         unweld(vertex_normals(asset->weld.V, asset->weld.F), asset->weld.to_welded);
 
@@ -214,8 +221,9 @@ val load_asset_js(const val& bytes_js, const std::string& name, const val& files
     o.set("toWelded", to_uint32_array(asset->weld.to_welded));
     o.set("weldedPositions", to_float64_array(asset->weld.V));
     o.set("weldedIndices", to_uint32_array(asset->weld.F));
-    o.set("report", report_object(report));
-    o.set("text", asset_text(*asset, report));
+    o.set("report", report_object(info.welded));
+    o.set("text", info.text);
+    o.set("info", val::global("JSON").call<val>("parse", info.json));
 
     const int id = g_next_asset_id++;
     asset_registry()[id] = std::move(asset);
@@ -302,9 +310,9 @@ val spectral_basis_js(const val& positions, const val& indices, const val& optio
   try {
     const Eigen::MatrixXd V = to_matrix(positions);
     const Eigen::MatrixXi F = to_index_matrix(indices);
-    // The eigensolver needs a usable surface: refuse NaN/out-of-range input with the
-    // validator's message rather than letting the factorization fail obscurely.
-    const Status valid = check_mesh(V, F);
+    // The eigensolver needs a manifold surface (as `meshmorph eigs` checks): refuse bad input
+    // with the validator's message rather than letting the factorization fail obscurely.
+    const Status valid = check_mesh(V, F, manifold_defects());
     if (!valid.ok()) return status_object(valid);
 
     SpectralBasisOptions opt;

@@ -87,6 +87,10 @@ LoadResult load_asset_from_memory(const std::vector<uint8_t>& bytes, Format form
 
 struct SaveOptions {
   bool recompute_normals = true;  // glTF: NORMAL of changed primitives recomputed from the result
+  // glTF: skin weights whose per-vertex sum is not 1 (which the Khronos validator reports as
+  // errors; some exporters write them) are replaced by normalized copies. Valid weights are
+  // never touched. Off: written back exactly as loaded.
+  bool repair_weights = true;
 };
 
 // Writes the asset with new welded positions V (#W by 3, world space; pass asset.weld.V to

@@ -1,1 +1,18 @@
-list(APPEND MM_IO_SOURCES core/io/asset_stub_for_build.cpp)
+# core/io: the Asset loader/saver (asset.h) and one reader/writer pair per format.
+list(APPEND MM_IO_SOURCES
+  core/io/asset.cpp
+  core/io/grouped_normals.cpp
+  core/io/io_text.cpp
+  core/io/obj.cpp
+  core/io/off.cpp
+  core/io/ply.cpp
+  core/io/gltf_uri.cpp
+  core/io/gltf_accessor.cpp
+  core/io/gltf_builder.cpp
+  core/io/gltf_load.cpp
+  core/io/gltf_serialize.cpp
+  core/io/gltf_save.cpp
+  core/io/gltf_export.cpp
+  core/io/tinygltf_impl.cpp)
+list(APPEND MM_TEST_SOURCES tests/io_test.cpp tests/io_gltf_test.cpp)
+list(APPEND MM_IO_SOURCES core/io/info_report.cpp)  # owned by the lead: the `info` report shared by CLI and wasm

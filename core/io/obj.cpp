@@ -26,7 +26,7 @@ static std::string_view obj_rest_after_tokens(std::string_view line, int n) {
 
 // Resolves one OBJ index (1-based, or negative = relative to the end) against `count`
 // elements defined so far. Returns -1 with *message set when invalid.
-static int obj_resolve_index(std::string_view token, int count, const char* what, int line,
+static int obj_resolve_index(std::string_view token, int count, const char* what, const char* plural, int line,
                              std::string* message) {
   long long k = 0;
   if (!parse_int_token(token, &k)) {
@@ -42,8 +42,8 @@ static int obj_resolve_index(std::string_view token, int count, const char* what
   const long long idx = k > 0 ? k - 1 : count + k;
   if (idx < 0 || idx >= count) {
     *message = "line " + std::to_string(line) + ": face references " + what + " " +
-               std::to_string(k) + " but only " + std::to_string(count) + " " + what +
-               (count == 1 ? " is" : "s are") + " defined before it";
+               std::to_string(k) + " but only " + std::to_string(count) + " " +
+               (count == 1 ? std::string(what) + " is" : std::string(plural) + " are") + " defined before it";
     return -1;
   }
   return static_cast<int>(idx);
@@ -96,18 +96,18 @@ Status load_obj(const std::vector<uint8_t>& bytes, Asset* asset) {
         const size_t s1 = t.find('/');
         const size_t s2 = s1 == std::string_view::npos ? s1 : t.find('/', s1 + 1);
         std::array<int, 3> k = {-1, -1, -1};
-        k[0] = obj_resolve_index(t.substr(0, s1), nv, "vertex", line_no, &message);
+        k[0] = obj_resolve_index(t.substr(0, s1), nv, "vertex", "vertices", line_no, &message);
         if (k[0] < 0) return Status::error(StatusCode::ParseError, asset->source_name + ": " + message);
         if (s1 != std::string_view::npos) {
           const std::string_view b = t.substr(s1 + 1, s2 == std::string_view::npos ? s2 : s2 - s1 - 1);
           if (!b.empty()) {
-            k[1] = obj_resolve_index(b, nt, "texture coordinate", line_no, &message);
+            k[1] = obj_resolve_index(b, nt, "texture coordinate", "texture coordinates", line_no, &message);
             if (k[1] < 0) return Status::error(StatusCode::ParseError, asset->source_name + ": " + message);
           }
           if (s2 != std::string_view::npos) {
             const std::string_view n = t.substr(s2 + 1);
             if (!n.empty()) {
-              k[2] = obj_resolve_index(n, nn, "normal", line_no, &message);
+              k[2] = obj_resolve_index(n, nn, "normal", "normals", line_no, &message);
               if (k[2] < 0) return Status::error(StatusCode::ParseError, asset->source_name + ": " + message);
             }
           }

@@ -1,5 +1,6 @@
 #include "linalg/polar.h"
 
+#include <Eigen/LU>
 #include <Eigen/SVD>
 
 namespace mm {

@@ -20,7 +20,8 @@ namespace mm {
 
 struct SpectralBasisOptions {
   int k = 20;                 // number of eigenpairs; 1 ≤ k < #V
-  int ncv = 0;                // Krylov subspace size; 0 = min(#V, max(2k + 1, k + 20))
+  int ncv = 0;                // Krylov subspace size; 0 = min(#V, max(2m + 1, m + 20)) with
+                              // m = k + max(5, k/10) (guard eigenpairs, see spectral_basis.cpp)
   double relative_shift = 1e-6; // σ = -relative_shift · tr(W)/tr(A): W - σA is SPD even though
                               // W is singular, and σ sits just below λ₀ = 0 for fast convergence
   double tolerance = 1e-10;   // Spectra's relative eigenvalue tolerance

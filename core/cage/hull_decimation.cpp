@@ -1,0 +1,464 @@
+#include "cage/hull_decimation.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iterator>
+#include <queue>
+#include <vector>
+
+#include "cage/cage_detail.h"
+
+namespace mm {
+
+namespace hull_detail {
+
+using cage_detail::Vec3;
+using cage_detail::cross;
+using cage_detail::dot;
+using cage_detail::norm;
+
+// Area-weighted plane quadric: Q(p) = Σ area·(n·p − d)², stored as the symmetric 4x4.
+struct Quadric {
+  double a00 = 0, a01 = 0, a02 = 0, a11 = 0, a12 = 0, a22 = 0, b0 = 0, b1 = 0, b2 = 0, c = 0, area = 0;
+  void add_plane(const Vec3& n, double d, double w) {
+    a00 += w * n.x * n.x; a01 += w * n.x * n.y; a02 += w * n.x * n.z;
+    a11 += w * n.y * n.y; a12 += w * n.y * n.z; a22 += w * n.z * n.z;
+    b0 -= w * n.x * d; b1 -= w * n.y * d; b2 -= w * n.z * d;
+    c += w * d * d;
+    area += w;
+  }
+  void add(const Quadric& q) {
+    a00 += q.a00; a01 += q.a01; a02 += q.a02; a11 += q.a11; a12 += q.a12; a22 += q.a22;
+    b0 += q.b0; b1 += q.b1; b2 += q.b2; c += q.c; area += q.area;
+  }
+  double eval(const Vec3& p) const {
+    const double x = p.x, y = p.y, z = p.z;
+    return a00 * x * x + 2 * a01 * x * y + 2 * a02 * x * z + a11 * y * y + 2 * a12 * y * z + a22 * z * z +
+           2 * (b0 * x + b1 * y + b2 * z) + c;
+  }
+  // Minimiser of Q when the 3x3 part is well conditioned.
+  bool minimiser(Vec3* p) const {
+    const double c00 = a11 * a22 - a12 * a12, c01 = a02 * a12 - a01 * a22, c02 = a01 * a12 - a02 * a11;
+    const double det = a00 * c00 + a01 * c01 + a02 * c02;
+    const double tr = (a00 + a11 + a22) / 3;
+    if (!(std::abs(det) > 1e-6 * tr * tr * tr) || !(tr > 0)) return false;
+    const double c11 = a00 * a22 - a02 * a02, c12 = a01 * a02 - a00 * a12, c22 = a00 * a11 - a01 * a01;
+    const double inv = 1.0 / det;
+    *p = Vec3(-(c00 * b0 + c01 * b1 + c02 * b2) * inv, -(c01 * b0 + c11 * b1 + c12 * b2) * inv,
+              -(c02 * b0 + c12 * b1 + c22 * b2) * inv);
+    return std::isfinite(p->x) && std::isfinite(p->y) && std::isfinite(p->z);
+  }
+};
+
+struct HeapEntry {
+  double cost;
+  int a, b;            // a < b
+  unsigned va, vb;     // versions of a and b when the entry was made
+  // std::priority_queue is a max-heap: "less" means "collapsed later".
+  bool operator<(const HeapEntry& o) const {
+    if (cost != o.cost) return cost > o.cost;
+    if (a != o.a) return a > o.a;
+    return b > o.b;
+  }
+};
+
+struct Candidate {
+  bool ok = false;
+  Vec3 p;
+  double cost = 0;
+};
+
+class Decimator {
+ public:
+  Decimator(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const HullDecimationOptions& opt)
+      : opt_(opt) {
+    const int n = static_cast<int>(V.rows());
+    pos_.resize(n);
+    for (int i = 0; i < n; ++i) pos_[i] = Vec3(V(i, 0), V(i, 1), V(i, 2));
+    faces_.resize(F.rows());
+    face_alive_.assign(F.rows(), 1);
+    vf_.resize(n);
+    quadric_.resize(n);
+    vert_alive_.assign(n, 0);
+    version_.assign(n, 0);
+    for (int f = 0; f < F.rows(); ++f) {
+      faces_[f] = {F(f, 0), F(f, 1), F(f, 2)};
+      for (int c = 0; c < 3; ++c) {
+        vf_[F(f, c)].push_back(f);
+        vert_alive_[F(f, c)] = 1;
+      }
+      const Vec3 A = face_area_vector(f);
+      const double a2 = norm(A);
+      if (a2 > 0) {
+        const Vec3 nrm = (1.0 / a2) * A;
+        const double d = dot(nrm, pos_[faces_[f][0]]);
+        for (int c = 0; c < 3; ++c) quadric_[F(f, c)].add_plane(nrm, d, 0.5 * a2);
+      }
+    }
+    alive_vertices_ = 0;
+    for (int i = 0; i < n; ++i) alive_vertices_ += vert_alive_[i];
+    alive_faces_ = static_cast<int>(F.rows());
+    stamp_.assign(F.rows(), 0);
+  }
+
+  int alive_vertices() const { return alive_vertices_; }
+
+  Status run(const Progress& progress, int* collapses) {
+    rebuild_grid();
+    for (int a = 0; a < static_cast<int>(pos_.size()); ++a) {
+      if (!vert_alive_[a]) continue;
+      for (int b : neighbours(a))
+        if (a < b) push(a, b);
+    }
+    const int start = alive_vertices_;
+    int done = 0;
+    while (alive_vertices_ > opt_.target_vertices && !heap_.empty()) {
+      const HeapEntry e = heap_.top();
+      heap_.pop();
+      if (!vert_alive_[e.a] || !vert_alive_[e.b] || version_[e.a] != e.va || version_[e.b] != e.vb) continue;
+      const Candidate c = candidate(e.a, e.b);
+      if (!c.ok) continue;
+      if (c.cost > e.cost + 1e-12 * std::abs(e.cost) + 1e-300) {
+        heap_.push({c.cost, e.a, e.b, e.va, e.vb});  // neighbourhood changed since: re-queue
+        continue;
+      }
+      if (!collapse(e.a, e.b, c.p)) continue;
+      ++done;
+      if (alive_faces_ * 2 < grid_faces_) rebuild_grid();
+      if (done % 512 == 0) {
+        const double f = double(start - alive_vertices_) / std::max(1, start - opt_.target_vertices);
+        if (!progress.update("cage: simplify", f)) return cancelled_status("cage: simplify");
+      }
+    }
+    *collapses = done;
+    return Status::success();
+  }
+
+  void output(Eigen::MatrixXd* V, Eigen::MatrixXi* F) const {
+    std::vector<int> remap(pos_.size(), -1);
+    int n = 0;
+    for (size_t i = 0; i < pos_.size(); ++i)
+      if (vert_alive_[i]) remap[i] = n++;
+    V->resize(n, 3);
+    for (size_t i = 0; i < pos_.size(); ++i)
+      if (remap[i] >= 0) {
+        (*V)(remap[i], 0) = pos_[i].x;
+        (*V)(remap[i], 1) = pos_[i].y;
+        (*V)(remap[i], 2) = pos_[i].z;
+      }
+    F->resize(alive_faces_, 3);
+    int m = 0;
+    for (size_t f = 0; f < faces_.size(); ++f)
+      if (face_alive_[f]) {
+        for (int c = 0; c < 3; ++c) (*F)(m, c) = remap[faces_[f][c]];
+        ++m;
+      }
+  }
+
+ private:
+  Vec3 face_area_vector(int f) const {
+    return cage_detail::area_vector(pos_[faces_[f][0]], pos_[faces_[f][1]], pos_[faces_[f][2]]);
+  }
+
+  // Alive incident faces of v (also drops dead ones from the list).
+  const std::vector<int>& faces_of(int v) {
+    auto& list = vf_[v];
+    list.erase(std::remove_if(list.begin(), list.end(), [&](int f) { return !face_alive_[f]; }), list.end());
+    return list;
+  }
+
+  std::vector<int> neighbours(int v) {
+    std::vector<int> out;
+    for (int f : faces_of(v))
+      for (int c = 0; c < 3; ++c)
+        if (faces_[f][c] != v) out.push_back(faces_[f][c]);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+
+  static bool has_vertex(const std::array<int, 3>& t, int v) { return t[0] == v || t[1] == v || t[2] == v; }
+
+  // Faces around a or b, each once (edge faces included).
+  std::vector<int> star(int a, int b) {
+    std::vector<int> s = faces_of(a);
+    for (int f : faces_of(b))
+      if (!has_vertex(faces_[f], a)) s.push_back(f);
+    return s;
+  }
+
+  Candidate candidate(int a, int b) {
+    Candidate best;
+    const std::vector<int> s = star(a, b);
+    Quadric q = quadric_[a];
+    q.add(quadric_[b]);
+    struct Plane { Vec3 n; double d; };
+    std::vector<Plane> planes;
+    planes.reserve(s.size());
+    Vec3 m;
+    for (int f : s) {
+      const Vec3 A = face_area_vector(f);
+      const double l = norm(A);
+      m = m + A;
+      if (l > 0) planes.push_back({(1.0 / l) * A, dot((1.0 / l) * A, pos_[faces_[f][0]])});
+    }
+    m = cage_detail::normalized(m);
+    const Vec3 pa = pos_[a], pb = pos_[b];
+    const double len2 = dot(pb - pa, pb - pa);
+    const double scale = std::sqrt(len2);
+    Vec3 cands[4];
+    int nc = 0;
+    Vec3 opt_p;
+    if (q.minimiser(&opt_p) && norm(opt_p - 0.5 * (pa + pb)) < 2 * scale) cands[nc++] = opt_p;
+    cands[nc++] = 0.5 * (pa + pb);
+    cands[nc++] = pa;
+    cands[nc++] = pb;
+    const double norm_area = q.area > 0 ? q.area : 1.0;
+    for (int i = 0; i < nc; ++i) {
+      Vec3 c = cands[i];
+      // Progressive hull: push along the mean normal until c is outside every plane.
+      double t = 0;
+      bool feasible = true;
+      for (const Plane& pl : planes) {
+        const double sdist = dot(pl.n, c) - pl.d;
+        if (sdist >= 0) continue;
+        const double nm = dot(pl.n, m);
+        if (nm <= 1e-3) {
+          feasible = false;
+          break;
+        }
+        t = std::max(t, -sdist / nm);
+      }
+      if (!feasible) continue;
+      if (t > 0) c = c + (t * (1 + 1e-9) + 1e-12 * scale) * m;
+      for (const Plane& pl : planes)
+        if (dot(pl.n, c) - pl.d < -1e-12 * scale) {
+          feasible = false;
+          break;
+        }
+      if (!feasible) continue;
+      const double cost = std::max(0.0, q.eval(c)) / norm_area + opt_.length_weight * len2;
+      if (!best.ok || cost < best.cost) {
+        best.ok = true;
+        best.p = c;
+        best.cost = cost;
+      }
+    }
+    return best;
+  }
+
+  void push(int a, int b) {
+    const Candidate c = candidate(a, b);
+    if (c.ok) heap_.push({c.cost, a, b, version_[a], version_[b]});
+  }
+
+  bool collapse(int a, int b, const Vec3& p) {
+    // Link condition: the common neighbours of a and b are exactly the two opposite vertices.
+    std::vector<int> edge_faces;
+    for (int f : faces_of(a))
+      if (has_vertex(faces_[f], b)) edge_faces.push_back(f);
+    if (edge_faces.size() != 2) return false;
+    int opposite[2];
+    for (int k = 0; k < 2; ++k) {
+      const auto& t = faces_[edge_faces[k]];
+      opposite[k] = t[0] != a && t[0] != b ? t[0] : (t[1] != a && t[1] != b ? t[1] : t[2]);
+    }
+    if (opposite[0] == opposite[1]) return false;
+    const std::vector<int> na = neighbours(a), nb = neighbours(b);
+    std::vector<int> common;
+    std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
+    if (common.size() != 2) return false;
+    if (static_cast<int>(na.size() + nb.size()) - 4 < 3) return false;
+    for (int k = 0; k < 2; ++k)
+      if (neighbours(opposite[k]).size() <= 3) return false;
+
+    // Surviving faces: new geometry must not flip, degenerate or hit unrelated faces.
+    const std::vector<int> s = star(a, b);
+    const double cos_turn = std::cos(opt_.max_normal_turn_deg * 3.14159265358979323846 / 180.0);
+    std::vector<std::array<Vec3, 3>> moved;
+    std::vector<std::array<int, 3>> moved_ids;
+    for (int f : s) {
+      const auto& t = faces_[f];
+      if (has_vertex(t, a) && has_vertex(t, b)) continue;
+      std::array<Vec3, 3> P;
+      std::array<int, 3> ids = t;
+      for (int c = 0; c < 3; ++c) {
+        if (t[c] == a || t[c] == b) {
+          P[c] = p;
+          ids[c] = a;
+        } else {
+          P[c] = pos_[t[c]];
+        }
+      }
+      const Vec3 old_n = face_area_vector(f);
+      const Vec3 new_n = cage_detail::area_vector(P[0], P[1], P[2]);
+      const double lo = norm(old_n), ln = norm(new_n);
+      if (!(ln > 1e-12 * (lo + 1e-300)) || !(ln > 0)) return false;
+      if (lo > 0 && dot(old_n, new_n) < cos_turn * lo * ln) return false;
+      moved.push_back(P);
+      moved_ids.push_back(ids);
+    }
+    if (opt_.check_self_intersections) {
+      for (size_t k = 0; k < moved.size(); ++k)
+        if (hits_other_face(moved[k], moved_ids[k], a, b)) return false;
+    }
+
+    // Apply.
+    for (int f : edge_faces) face_alive_[f] = 0;
+    alive_faces_ -= 2;
+    pos_[a] = p;
+    quadric_[a].add(quadric_[b]);
+    for (int f : faces_of(b)) {
+      for (int c = 0; c < 3; ++c)
+        if (faces_[f][c] == b) faces_[f][c] = a;
+      vf_[a].push_back(f);
+    }
+    vf_[b].clear();
+    vert_alive_[b] = 0;
+    --alive_vertices_;
+    ++version_[a];
+    ++version_[b];
+    auto& list = vf_[a];
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+    for (int f : faces_of(a)) grid_insert(f);
+    for (int x : neighbours(a)) push(std::min(a, x), std::max(a, x));
+    return true;
+  }
+
+  // --- uniform grid over face bounding boxes, rebuilt as faces grow ---
+  void rebuild_grid() {
+    double edge_sum = 0;
+    int edges = 0;
+    Vec3 lo(1e300, 1e300, 1e300), hi(-1e300, -1e300, -1e300);
+    for (size_t f = 0; f < faces_.size(); ++f) {
+      if (!face_alive_[f]) continue;
+      for (int c = 0; c < 3; ++c) {
+        const Vec3& P = pos_[faces_[f][c]];
+        lo = Vec3(std::min(lo.x, P.x), std::min(lo.y, P.y), std::min(lo.z, P.z));
+        hi = Vec3(std::max(hi.x, P.x), std::max(hi.y, P.y), std::max(hi.z, P.z));
+        edge_sum += norm(pos_[faces_[f][(c + 1) % 3]] - P);
+        ++edges;
+      }
+    }
+    const Vec3 ext = hi - lo;
+    double cs = 2.0 * edge_sum / std::max(1, edges);
+    const double longest = std::max({ext.x, ext.y, ext.z, 1e-300});
+    cs = std::max(cs, longest / 96.0);  // at most ~96 cells along the longest side
+    grid_lo_ = lo - Vec3(cs, cs, cs);
+    cell_ = cs;
+    for (int k = 0; k < 3; ++k) dims_[k] = static_cast<int>(std::ceil((ext[k] + 2 * cs) / cs)) + 1;
+    cells_.assign(static_cast<size_t>(dims_[0]) * dims_[1] * dims_[2], {});
+    for (size_t f = 0; f < faces_.size(); ++f)
+      if (face_alive_[f]) grid_insert(static_cast<int>(f));
+    grid_faces_ = alive_faces_;
+  }
+
+  void cell_range(const Vec3& lo, const Vec3& hi, int r0[3], int r1[3]) const {
+    for (int k = 0; k < 3; ++k) {
+      r0[k] = std::clamp(static_cast<int>(std::floor((lo[k] - grid_lo_[k]) / cell_)), 0, dims_[k] - 1);
+      r1[k] = std::clamp(static_cast<int>(std::floor((hi[k] - grid_lo_[k]) / cell_)), 0, dims_[k] - 1);
+    }
+  }
+
+  static void bbox(const std::array<Vec3, 3>& P, Vec3* lo, Vec3* hi) {
+    *lo = Vec3(std::min({P[0].x, P[1].x, P[2].x}), std::min({P[0].y, P[1].y, P[2].y}),
+               std::min({P[0].z, P[1].z, P[2].z}));
+    *hi = Vec3(std::max({P[0].x, P[1].x, P[2].x}), std::max({P[0].y, P[1].y, P[2].y}),
+               std::max({P[0].z, P[1].z, P[2].z}));
+  }
+
+  std::array<Vec3, 3> face_points(int f) const {
+    return {pos_[faces_[f][0]], pos_[faces_[f][1]], pos_[faces_[f][2]]};
+  }
+
+  void grid_insert(int f) {
+    Vec3 lo, hi;
+    bbox(face_points(f), &lo, &hi);
+    int r0[3], r1[3];
+    cell_range(lo, hi, r0, r1);
+    for (int z = r0[2]; z <= r1[2]; ++z)
+      for (int y = r0[1]; y <= r1[1]; ++y)
+        for (int x = r0[0]; x <= r1[0]; ++x)
+          cells_[x + static_cast<size_t>(dims_[0]) * (y + static_cast<size_t>(dims_[1]) * z)].push_back(f);
+  }
+
+  bool hits_other_face(const std::array<Vec3, 3>& P, const std::array<int, 3>& ids, int a, int b) {
+    Vec3 lo, hi;
+    bbox(P, &lo, &hi);
+    int r0[3], r1[3];
+    cell_range(lo, hi, r0, r1);
+    ++query_;
+    for (int z = r0[2]; z <= r1[2]; ++z)
+      for (int y = r0[1]; y <= r1[1]; ++y)
+        for (int x = r0[0]; x <= r1[0]; ++x) {
+          auto& cell = cells_[x + static_cast<size_t>(dims_[0]) * (y + static_cast<size_t>(dims_[1]) * z)];
+          for (int g : cell) {
+            if (stamp_[g] == query_ || !face_alive_[g]) continue;
+            stamp_[g] = query_;
+            const auto& t = faces_[g];
+            bool shares = has_vertex(t, a) || has_vertex(t, b);
+            for (int c = 0; c < 3 && !shares; ++c) shares = has_vertex(t, ids[c]);
+            if (shares) continue;
+            const auto Q = face_points(g);
+            Vec3 qlo, qhi;
+            bbox(Q, &qlo, &qhi);
+            if (qlo.x > hi.x || qlo.y > hi.y || qlo.z > hi.z || qhi.x < lo.x || qhi.y < lo.y || qhi.z < lo.z)
+              continue;
+            if (cage_detail::triangles_intersect(P[0], P[1], P[2], Q[0], Q[1], Q[2])) return true;
+          }
+          // Drop stale entries lazily so cells do not grow without bound.
+          if (cell.size() > 64)
+            cell.erase(std::remove_if(cell.begin(), cell.end(), [&](int g) { return !face_alive_[g]; }), cell.end());
+        }
+    return false;
+  }
+
+  HullDecimationOptions opt_;
+  std::vector<Vec3> pos_;
+  std::vector<std::array<int, 3>> faces_;
+  std::vector<uint8_t> face_alive_;
+  std::vector<std::vector<int>> vf_;
+  std::vector<Quadric> quadric_;
+  std::vector<uint8_t> vert_alive_;
+  std::vector<unsigned> version_;
+  std::priority_queue<HeapEntry> heap_;
+  int alive_vertices_ = 0, alive_faces_ = 0, grid_faces_ = 0;
+  // grid
+  Vec3 grid_lo_;
+  double cell_ = 1;
+  int dims_[3] = {1, 1, 1};
+  std::vector<std::vector<int>> cells_;
+  std::vector<unsigned> stamp_;
+  unsigned query_ = 0;
+};
+
+}  // namespace hull_detail
+
+HullDecimation hull_decimation(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                               const HullDecimationOptions& opt, const Progress& progress) {
+  HullDecimation out;
+  if (opt.target_vertices < 4) {
+    out.status = Status::error(StatusCode::InvalidArgument, "hull decimation needs a target of at least 4 vertices");
+    return out;
+  }
+  if (V.rows() < 4 || F.rows() < 4 || !V.allFinite()) {
+    out.status = Status::error(StatusCode::InvalidMesh, "hull decimation needs a closed mesh with finite coordinates");
+    return out;
+  }
+  for (int f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c)
+      if (F(f, c) < 0 || F(f, c) >= V.rows()) {
+        out.status = Status::error(StatusCode::InvalidMesh, "face " + std::to_string(f) + " has an invalid vertex index");
+        return out;
+      }
+  hull_detail::Decimator d(V, F, opt);
+  out.status = d.run(progress, &out.collapses);
+  if (!out.status.ok()) return out;
+  d.output(&out.V, &out.F);
+  progress.update("cage: simplify", 1.0);
+  return out;
+}
+
+}  // namespace mm

@@ -1,0 +1,128 @@
+#include "cage/mean_value_coordinates.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <vector>
+
+namespace mm {
+
+MeanValueCoordinates mean_value_coordinates(const Eigen::MatrixXd& P, const Eigen::MatrixXd& C,
+                                            const Eigen::MatrixXi& CF, const Progress& progress) {
+  MeanValueCoordinates out;
+  const int np = static_cast<int>(P.rows());
+  const int nc = static_cast<int>(C.rows());
+  const int nf = static_cast<int>(CF.rows());
+  if (nc < 4 || nf < 4 || !C.allFinite()) {
+    out.status = Status::error(StatusCode::InvalidArgument, "mean-value coordinates need a closed cage with finite vertices");
+    return out;
+  }
+  // Unique undirected edges; each face refers to the edge opposite each of its corners.
+  std::map<std::pair<int, int>, int> edge_id;  // ordered: edge numbering is deterministic
+  std::vector<std::array<int, 2>> edges;
+  std::vector<std::array<int, 3>> face_edge(nf);
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = CF(f, (k + 1) % 3), b = CF(f, (k + 2) % 3);
+      if (a < 0 || b < 0 || a >= nc || b >= nc || a == b) {
+        out.status = Status::error(StatusCode::InvalidArgument, "cage face " + std::to_string(f) + " is invalid");
+        return out;
+      }
+      const auto key = std::make_pair(std::min(a, b), std::max(a, b));
+      auto it = edge_id.find(key);
+      if (it == edge_id.end()) {
+        it = edge_id.emplace(key, static_cast<int>(edges.size())).first;
+        edges.push_back({key.first, key.second});
+      }
+      face_edge[f][k] = it->second;
+    }
+  const int ne = static_cast<int>(edges.size());
+  const double scale = (C.colwise().maxCoeff() - C.colwise().minCoeff()).norm();
+  const double vertex_eps = 1e-12 * scale;
+  constexpr double kPi = 3.14159265358979323846;
+
+  out.Psi.setZero(np, nc);
+  std::vector<double> ux(nc), uy(nc), uz(nc), d(nc), w(nc);
+  std::vector<double> th(ne), sn(ne), cs(ne);
+  for (int p = 0; p < np; ++p) {
+    if ((p & 511) == 0 && !progress.update("mean-value coordinates", double(p) / std::max(1, np))) {
+      out.status = cancelled_status("mean-value coordinates");
+      return out;
+    }
+    const double x = P(p, 0), y = P(p, 1), z = P(p, 2);
+    int at_vertex = -1;
+    for (int j = 0; j < nc; ++j) {
+      const double ex = C(j, 0) - x, ey = C(j, 1) - y, ez = C(j, 2) - z;
+      const double dj = std::sqrt(ex * ex + ey * ey + ez * ez);
+      if (dj < vertex_eps) {
+        at_vertex = j;
+        break;
+      }
+      d[j] = dj;
+      ux[j] = ex / dj;
+      uy[j] = ey / dj;
+      uz[j] = ez / dj;
+    }
+    if (at_vertex >= 0) {
+      out.Psi(p, at_vertex) = 1.0;
+      continue;
+    }
+    for (int e = 0; e < ne; ++e) {
+      const int a = edges[e][0], b = edges[e][1];
+      const double dx = ux[a] - ux[b], dy = uy[a] - uy[b], dz = uz[a] - uz[b];
+      const double l = std::sqrt(dx * dx + dy * dy + dz * dz);
+      const double half = std::min(1.0, 0.5 * l);
+      th[e] = 2.0 * std::asin(half);
+      sn[e] = 2.0 * half * std::sqrt(std::max(0.0, 1.0 - half * half));
+      cs[e] = 1.0 - 2.0 * half * half;
+    }
+    std::fill(w.begin(), w.end(), 0.0);
+    bool on_face = false;
+    for (int f = 0; f < nf && !on_face; ++f) {
+      const int i0 = CF(f, 0), i1 = CF(f, 1), i2 = CF(f, 2);
+      const int e0 = face_edge[f][0], e1 = face_edge[f][1], e2 = face_edge[f][2];
+      const double det = ux[i0] * (uy[i1] * uz[i2] - uz[i1] * uy[i2]) -
+                         uy[i0] * (ux[i1] * uz[i2] - uz[i1] * ux[i2]) +
+                         uz[i0] * (ux[i1] * uy[i2] - uy[i1] * ux[i2]);
+      const double t0 = th[e0], t1 = th[e1], t2 = th[e2];
+      if (std::abs(det) < 1e-10) {
+        const double h = 0.5 * (t0 + t1 + t2);
+        if (kPi - h < 1e-7) {
+          // On the face: 2D barycentric coordinates (JSW Fig. 4).
+          std::fill(w.begin(), w.end(), 0.0);
+          w[i0] = sn[e0] * d[i2] * d[i1];
+          w[i1] = sn[e1] * d[i0] * d[i2];
+          w[i2] = sn[e2] * d[i1] * d[i0];
+          on_face = true;
+        }
+        continue;  // in the face's plane but outside it: no contribution
+      }
+      const double s0 = sn[e0], s1 = sn[e1], s2 = sn[e2];
+      const double c0 = cs[e0], c1 = cs[e1], c2 = cs[e2];
+      const double C0 = (c0 - c1 * c2) / (s1 * s2);
+      const double C1 = (c1 - c2 * c0) / (s2 * s0);
+      const double C2 = (c2 - c0 * c1) / (s0 * s1);
+      w[i0] += s0 * (t0 - C1 * t2 - C2 * t1) / (d[i0] * det);
+      w[i1] += s1 * (t1 - C2 * t0 - C0 * t2) / (d[i1] * det);
+      w[i2] += s2 * (t2 - C0 * t1 - C1 * t0) / (d[i2] * det);
+    }
+    double sum = 0;
+    for (int j = 0; j < nc; ++j) sum += w[j];
+    if (!(std::abs(sum) > 0) || !std::isfinite(sum)) {
+      out.status = Status::error(StatusCode::NumericalError,
+                                 "mean-value weights of point " + std::to_string(p) + " cancel (is it inside the cage?)");
+      return out;
+    }
+    const double inv = 1.0 / sum;
+    for (int j = 0; j < nc; ++j) out.Psi(p, j) = w[j] * inv;
+  }
+  if (!out.Psi.allFinite()) {
+    out.status = Status::error(StatusCode::NumericalError, "mean-value coordinates are not finite");
+    return out;
+  }
+  progress.update("mean-value coordinates", 1.0);
+  return out;
+}
+
+}  // namespace mm

@@ -1,0 +1,2 @@
+list(APPEND MM_CORE_SOURCES core/edit/selection.cpp core/edit/implicit_gradients.cpp core/edit/laplacian_editor.cpp)
+list(APPEND MM_TEST_SOURCES tests/edit_test.cpp)

@@ -1,0 +1,146 @@
+#include "io/gltf_accessor.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+
+namespace mm::io {
+
+int gltf_component_count(int type) {
+  switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return 1;
+    case TINYGLTF_TYPE_VEC2: return 2;
+    case TINYGLTF_TYPE_VEC3: return 3;
+    case TINYGLTF_TYPE_VEC4: return 4;
+    case TINYGLTF_TYPE_MAT2: return 4;
+    case TINYGLTF_TYPE_MAT3: return 9;
+    case TINYGLTF_TYPE_MAT4: return 16;
+  }
+  return 0;
+}
+
+int gltf_component_size(int component_type) {
+  switch (component_type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+  }
+  return 0;
+}
+
+namespace detail {
+
+static double accessor_component(const uint8_t* p, int component_type, bool normalized) {
+  // Little-endian storage (glTF) on little-endian hosts (x86-64, wasm32).
+  switch (component_type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+      int8_t v; std::memcpy(&v, p, 1);
+      return normalized ? std::max(v / 127.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      int16_t v; std::memcpy(&v, p, 2);
+      return normalized ? std::max(v / 32767.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      uint16_t v; std::memcpy(&v, p, 2);
+      return normalized ? v / 65535.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+      uint32_t v; std::memcpy(&v, p, 4);
+      return normalized ? v / 4294967295.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+      float v; std::memcpy(&v, p, 4);
+      return v;
+    }
+  }
+  return 0;
+}
+
+// Start of `count` elements of `elem_size` bytes at `stride` from `offset` in bufferView `bv`,
+// or nullptr with *status set when any of it lies outside the buffer.
+static const uint8_t* accessor_view_data(const tinygltf::Model& model, int bv, uint64_t offset, uint64_t count,
+                                         uint64_t elem_size, uint64_t stride, const std::string& what,
+                                         Status* status) {
+  auto fail = [&](const std::string& why) {
+    *status = Status::error(StatusCode::ParseError, what + ": " + why);
+    return nullptr;
+  };
+  if (bv < 0 || bv >= static_cast<int>(model.bufferViews.size()))
+    return fail("bufferView " + std::to_string(bv) + " does not exist");
+  const tinygltf::BufferView& view = model.bufferViews[bv];
+  if (view.buffer < 0 || view.buffer >= static_cast<int>(model.buffers.size()))
+    return fail("bufferView " + std::to_string(bv) + " refers to missing buffer " + std::to_string(view.buffer));
+  const std::vector<unsigned char>& data = model.buffers[view.buffer].data;
+  if (static_cast<uint64_t>(view.byteOffset) + view.byteLength > data.size())
+    return fail("bufferView " + std::to_string(bv) + " (offset " + std::to_string(view.byteOffset) + ", length " +
+                std::to_string(view.byteLength) + ") lies outside its buffer of " + std::to_string(data.size()) +
+                " bytes");
+  if (count > 0 && offset + (count - 1) * stride + elem_size > view.byteLength)
+    return fail(std::to_string(count) + " elements of " + std::to_string(elem_size) + " bytes (stride " +
+                std::to_string(stride) + ", offset " + std::to_string(offset) + ") overrun bufferView " +
+                std::to_string(bv) + " of " + std::to_string(view.byteLength) + " bytes");
+  return data.data() + view.byteOffset + offset;
+}
+
+}  // namespace detail
+
+Status read_gltf_accessor(const tinygltf::Model& model, int index, Eigen::MatrixXd* out) {
+  using namespace detail;
+  const std::string what = "accessor " + std::to_string(index);
+  if (index < 0 || index >= static_cast<int>(model.accessors.size()))
+    return Status::error(StatusCode::ParseError, what + " does not exist");
+  const tinygltf::Accessor& a = model.accessors[index];
+  const int nc = gltf_component_count(a.type), cs = gltf_component_size(a.componentType);
+  if (nc == 0 || cs == 0)
+    return Status::error(StatusCode::ParseError, what + " has an unknown type or componentType");
+  // A count above 2^31 cannot be backed by a GLB (4 GiB) with 2-byte elements; refuse it
+  // before allocating.
+  if (a.count > (size_t{1} << 31)) return Status::error(StatusCode::ParseError, what + " has an absurd count");
+  const uint64_t count = a.count, elem = static_cast<uint64_t>(nc) * cs;
+  out->setZero(static_cast<Eigen::Index>(count), nc);
+  Status status;
+  if (a.bufferView >= 0) {
+    const int stride_field = model.bufferViews.size() > static_cast<size_t>(a.bufferView)
+                                 ? model.bufferViews[a.bufferView].byteStride
+                                 : 0;
+    const uint64_t stride = stride_field > 0 ? static_cast<uint64_t>(stride_field) : elem;
+    if (stride < elem)
+      return Status::error(StatusCode::ParseError, what + ": byteStride " + std::to_string(stride) +
+                                                       " is smaller than the element size " + std::to_string(elem));
+    const uint8_t* p = accessor_view_data(model, a.bufferView, a.byteOffset, count, elem, stride, what, &status);
+    if (!p) return status;
+    for (uint64_t i = 0; i < count; ++i)
+      for (int c = 0; c < nc; ++c)
+        (*out)(static_cast<Eigen::Index>(i), c) = accessor_component(p + i * stride + c * cs, a.componentType, a.normalized);
+  }
+  if (a.sparse.isSparse) {
+    const uint64_t n = static_cast<uint64_t>(std::max(a.sparse.count, 0));
+    if (n > count) return Status::error(StatusCode::ParseError, what + ": sparse count exceeds the accessor count");
+    const int ict = a.sparse.indices.componentType, ics = gltf_component_size(ict);
+    if (ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+      return Status::error(StatusCode::ParseError, what + ": sparse indices must be unsigned integers");
+    const uint8_t* pi = accessor_view_data(model, a.sparse.indices.bufferView, a.sparse.indices.byteOffset, n, ics,
+                                           ics, what + " sparse indices", &status);
+    if (!pi) return status;
+    const uint8_t* pv = accessor_view_data(model, a.sparse.values.bufferView, a.sparse.values.byteOffset, n, elem,
+                                           elem, what + " sparse values", &status);
+    if (!pv) return status;
+    for (uint64_t k = 0; k < n; ++k) {
+      const double target = accessor_component(pi + k * ics, ict, false);
+      if (target >= static_cast<double>(count))
+        return Status::error(StatusCode::ParseError, what + ": sparse index " + std::to_string(static_cast<uint64_t>(target)) +
+                                                         " is beyond the accessor count " + std::to_string(count));
+      for (int c = 0; c < nc; ++c)
+        (*out)(static_cast<Eigen::Index>(target), c) = accessor_component(pv + k * elem + c * cs, a.componentType, a.normalized);
+    }
+  }
+  return Status::success();
+}
+
+}  // namespace mm::io

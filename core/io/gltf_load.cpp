@@ -1,0 +1,412 @@
+#include "io/gltf_load.h"
+
+#include <cstring>
+#include <map>
+#include <sstream>
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+#include "io/gltf_accessor.h"
+#include "io/gltf_document.h"
+#include "io/gltf_uri.h"
+
+namespace mm::io {
+
+const tinygltf::Model* gltf_model(const Asset& asset) {
+  const Document* d = asset.document.get();
+  if (!d || (d->source_format != Format::Gltf && d->source_format != Format::Glb)) return nullptr;
+  return &static_cast<const GltfDocument*>(d)->model;
+}
+
+std::shared_ptr<Document> make_gltf_document(tinygltf::Model model) {
+  auto doc = std::make_shared<GltfDocument>();
+  doc->model = std::move(model);
+  doc->image_files.resize(doc->model.images.size());
+  return doc;
+}
+
+namespace detail {
+
+// External files read before tinygltf parses, served to it through FsCallbacks so that the
+// same code runs natively (files next to the .gltf) and in the browser (files the user dropped).
+struct GltfFsContext {
+  std::map<std::string, std::vector<uint8_t>> files;  // decoded URI -> bytes
+};
+
+static std::string gltf_fs_key(const std::string& path) {
+  // tinygltf tries "<basedir>/<uri>" with an empty basedir (the URI itself) and then "./<uri>".
+  return path.compare(0, 2, "./") == 0 ? path.substr(2) : path;
+}
+
+static bool gltf_fs_exists(const std::string& path, void* user) {
+  const auto* ctx = static_cast<GltfFsContext*>(user);
+  return ctx->files.count(gltf_fs_key(path)) > 0;
+}
+
+static std::string gltf_fs_expand(const std::string& path, void*) { return path; }
+
+static bool gltf_fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  const auto* ctx = static_cast<GltfFsContext*>(user);
+  const auto it = ctx->files.find(gltf_fs_key(path));
+  if (it == ctx->files.end()) {
+    if (err) *err += "not available: " + path;
+    return false;
+  }
+  out->assign(it->second.begin(), it->second.end());
+  return true;
+}
+
+static bool gltf_fs_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err += "writing is not allowed while loading";
+  return false;
+}
+
+// Images are never decoded: the encoded bytes (PNG, JPEG, KTX2, ...) are kept so that saving
+// writes them back unchanged. bufferView images stay in their buffer.
+static bool gltf_keep_image_bytes(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                                  const unsigned char* bytes, int size, void*) {
+  image->as_is = true;
+  if (image->bufferView < 0 && bytes && size > 0) image->image.assign(bytes, bytes + size);
+  return true;
+}
+
+static uint32_t gltf_read_u32(const uint8_t* p) {
+  return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
+
+// Checks the GLB container (which tinygltf trusts) and returns its JSON chunk.
+static Status gltf_glb_json(const std::vector<uint8_t>& b, const std::string& name, std::string* json,
+                            uint64_t* bin_size) {
+  auto fail = [&](StatusCode c, const std::string& why) { return Status::error(c, name + ": " + why); };
+  if (b.size() < 12) return fail(StatusCode::ParseError, "truncated GLB: " + std::to_string(b.size()) +
+                                                              " bytes, less than the 12-byte header");
+  if (std::memcmp(b.data(), "glTF", 4) != 0) {
+    const bool looks_json = b[0] == '{' || b[0] == ' ' || b[0] == '\n';
+    return fail(StatusCode::ParseError, std::string("not a GLB file (no 'glTF' magic)") +
+                                            (looks_json ? "; it looks like a .gltf JSON file, rename it to .gltf" : ""));
+  }
+  const uint32_t version = gltf_read_u32(&b[4]), length = gltf_read_u32(&b[8]);
+  if (version != 2)
+    return fail(StatusCode::Unsupported, "GLB version " + std::to_string(version) + " (only glTF 2.0 is supported)");
+  if (length > b.size())
+    return fail(StatusCode::ParseError, "truncated GLB: the header declares " + std::to_string(length) +
+                                            " bytes but the file has " + std::to_string(b.size()));
+  if (length < 20) return fail(StatusCode::ParseError, "truncated GLB: no JSON chunk");
+  const uint32_t json_len = gltf_read_u32(&b[12]), json_type = gltf_read_u32(&b[16]);
+  if (json_type != 0x4E4F534A) return fail(StatusCode::ParseError, "the first GLB chunk is not JSON");
+  if (uint64_t(20) + json_len > length)
+    return fail(StatusCode::ParseError, "truncated GLB: the JSON chunk (" + std::to_string(json_len) +
+                                            " bytes) runs past the end of the file");
+  json->assign(reinterpret_cast<const char*>(&b[20]), json_len);
+  *bin_size = 0;
+  const uint64_t bin_at = 20 + uint64_t(json_len);
+  if (bin_at + 8 <= length) {
+    const uint32_t bin_len = gltf_read_u32(&b[bin_at]), bin_type = gltf_read_u32(&b[bin_at + 4]);
+    if (bin_type == 0x004E4942) {
+      if (bin_at + 8 + bin_len > length)
+        return fail(StatusCode::ParseError, "truncated GLB: the BIN chunk declares " + std::to_string(bin_len) +
+                                                " bytes but only " + std::to_string(length - bin_at - 8) + " follow");
+      *bin_size = bin_len;
+    }
+  }
+  return Status::success();
+}
+
+static uint64_t gltf_json_uint(const nlohmann::json& o, const char* key, uint64_t fallback) {
+  const auto it = o.find(key);
+  if (it == o.end() || !it->is_number_unsigned()) return it != o.end() && it->is_number_integer() && it->get<int64_t>() >= 0
+                                                              ? static_cast<uint64_t>(it->get<int64_t>())
+                                                              : fallback;
+  return it->get<uint64_t>();
+}
+
+// What tinygltf does not check before touching memory (image bufferViews are read during
+// parsing) plus the URI policy; also reads external files through the resolver.
+static Status gltf_precheck(const nlohmann::json& j, bool binary, uint64_t bin_size, const std::string& name,
+                            const FileResolver& resolver, GltfFsContext* fs,
+                            std::vector<std::vector<uint8_t>>* image_files, std::vector<std::string>* warnings) {
+  auto fail = [&](StatusCode c, const std::string& why) { return Status::error(c, name + ": " + why); };
+  if (!j.is_object()) return fail(StatusCode::ParseError, "glTF JSON must be an object");
+  const auto asset_it = j.find("asset");
+  if (asset_it != j.end() && asset_it->is_object()) {
+    const auto v = asset_it->find("version");
+    if (v != asset_it->end() && v->is_string() && v->get<std::string>().rfind("2.", 0) != 0)
+      return fail(StatusCode::Unsupported, "glTF version " + v->get<std::string>() + " (only glTF 2.0 is supported)");
+  }
+  std::vector<uint64_t> buffer_len;
+  const auto buffers = j.find("buffers");
+  if (buffers != j.end() && buffers->is_array()) {
+    for (size_t i = 0; i < buffers->size(); ++i) {
+      const nlohmann::json& b = (*buffers)[i];
+      if (!b.is_object()) return fail(StatusCode::ParseError, "buffer " + std::to_string(i) + " is not an object");
+      buffer_len.push_back(gltf_json_uint(b, "byteLength", 0));
+      const auto uri_it = b.find("uri");
+      if (uri_it == b.end() || !uri_it->is_string()) {
+        if (!(binary && i == 0))
+          return fail(StatusCode::ParseError, "buffer " + std::to_string(i) + " has no uri");
+        if (buffer_len.back() > bin_size)
+          return fail(StatusCode::ParseError, "buffer 0 declares " + std::to_string(buffer_len.back()) +
+                                                  " bytes but the GLB BIN chunk has " + std::to_string(bin_size));
+        continue;
+      }
+      const std::string uri = uri_it->get<std::string>();
+      if (is_data_uri(uri)) continue;
+      const std::string decoded = uri_decode(uri);
+      Status s = check_relative_uri(decoded, name + ": buffer " + std::to_string(i));
+      if (!s.ok()) return s;
+      std::vector<uint8_t> bytes;
+      if (!resolver || !resolver(decoded, &bytes))
+        return fail(StatusCode::IoError, "buffer " + std::to_string(i) + " refers to the missing file '" + decoded +
+                                             "' (it must be next to the .gltf file)");
+      if (bytes.size() < buffer_len.back())
+        return fail(StatusCode::ParseError, "'" + decoded + "' has " + std::to_string(bytes.size()) +
+                                                " bytes but buffer " + std::to_string(i) + " declares " +
+                                                std::to_string(buffer_len.back()));
+      // The glTF spec allows a file longer than byteLength (padding); tinygltf wants exact.
+      bytes.resize(buffer_len.back());
+      fs->files[decoded] = std::move(bytes);
+    }
+  }
+  std::vector<std::pair<uint64_t, uint64_t>> views;  // buffer, end offset
+  const auto bvs = j.find("bufferViews");
+  if (bvs != j.end() && bvs->is_array()) {
+    for (size_t i = 0; i < bvs->size(); ++i) {
+      const nlohmann::json& v = (*bvs)[i];
+      if (!v.is_object()) return fail(StatusCode::ParseError, "bufferView " + std::to_string(i) + " is not an object");
+      const uint64_t buf = gltf_json_uint(v, "buffer", UINT64_MAX);
+      const uint64_t end = gltf_json_uint(v, "byteOffset", 0) + gltf_json_uint(v, "byteLength", 0);
+      if (buf >= buffer_len.size())
+        return fail(StatusCode::ParseError, "bufferView " + std::to_string(i) + " refers to a missing buffer");
+      if (end > buffer_len[buf])
+        return fail(StatusCode::ParseError, "bufferView " + std::to_string(i) + " ends at byte " + std::to_string(end) +
+                                                " beyond buffer " + std::to_string(buf) + " (" +
+                                                std::to_string(buffer_len[buf]) + " bytes)");
+      views.emplace_back(buf, end);
+    }
+  }
+  const auto images = j.find("images");
+  if (images != j.end() && images->is_array()) {
+    image_files->resize(images->size());
+    for (size_t i = 0; i < images->size(); ++i) {
+      const nlohmann::json& im = (*images)[i];
+      if (!im.is_object()) return fail(StatusCode::ParseError, "image " + std::to_string(i) + " is not an object");
+      if (im.contains("bufferView")) {
+        if (gltf_json_uint(im, "bufferView", UINT64_MAX) >= views.size())
+          return fail(StatusCode::ParseError, "image " + std::to_string(i) + " refers to a missing bufferView");
+        continue;
+      }
+      const auto uri_it = im.find("uri");
+      if (uri_it == im.end() || !uri_it->is_string()) continue;  // tinygltf reports it
+      const std::string uri = uri_it->get<std::string>();
+      if (is_data_uri(uri)) continue;
+      const std::string decoded = uri_decode(uri);
+      Status s = check_relative_uri(decoded, name + ": image " + std::to_string(i));
+      if (!s.ok()) return s;
+      if (!resolver || !resolver(decoded, &(*image_files)[i]))
+        warnings->push_back("image " + std::to_string(i) + " ('" + decoded +
+                            "') was not found; its URI is kept but the image cannot be embedded on export");
+    }
+  }
+  return Status::success();
+}
+
+// Local transform of a node: its matrix, or T * R * S.
+static Eigen::Matrix4d gltf_node_local(const tinygltf::Node& n) {
+  Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
+  if (n.matrix.size() == 16) {
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) M(r, c) = n.matrix[c * 4 + r];  // column-major in glTF
+    return M;
+  }
+  Eigen::Affine3d T = Eigen::Affine3d::Identity();
+  if (n.translation.size() == 3) T.translate(Eigen::Vector3d(n.translation[0], n.translation[1], n.translation[2]));
+  if (n.rotation.size() == 4)
+    T.rotate(Eigen::Quaterniond(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]).normalized());
+  if (n.scale.size() == 3) T.scale(Eigen::Vector3d(n.scale[0], n.scale[1], n.scale[2]));
+  return T.matrix();
+}
+
+static const char* gltf_mode_name(int mode) {
+  switch (mode) {
+    case TINYGLTF_MODE_POINTS: return "POINTS";
+    case TINYGLTF_MODE_LINE: return "LINES";
+    case TINYGLTF_MODE_LINE_LOOP: return "LINE_LOOP";
+    case TINYGLTF_MODE_LINE_STRIP: return "LINE_STRIP";
+    case TINYGLTF_MODE_TRIANGLE_STRIP: return "TRIANGLE_STRIP";
+    case TINYGLTF_MODE_TRIANGLE_FAN: return "TRIANGLE_FAN";
+  }
+  return "unknown";
+}
+
+}  // namespace detail
+
+Status load_gltf(const std::vector<uint8_t>& bytes, Format format, const FileResolver& resolver,
+                 const LoadOptions& opt, Asset* asset) {
+  using namespace detail;
+  const std::string& name = asset->source_name;
+  const bool binary = format == Format::Glb;
+  std::string json_text;
+  uint64_t bin_size = 0;
+  if (binary) {
+    Status s = gltf_glb_json(bytes, name, &json_text, &bin_size);
+    if (!s.ok()) return s;
+  } else {
+    json_text.assign(bytes.begin(), bytes.end());
+  }
+  auto doc = std::make_shared<GltfDocument>();
+  GltfFsContext fs;
+  try {
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(json_text);
+    } catch (const nlohmann::json::exception& e) {
+      return Status::error(StatusCode::ParseError, name + ": invalid glTF JSON: " + e.what());
+    }
+    Status s = gltf_precheck(j, binary, bin_size, name, resolver, &fs, &doc->image_files, &asset->warnings);
+    if (!s.ok()) return s;
+  } catch (const std::exception& e) {
+    return Status::error(StatusCode::ParseError, name + ": malformed glTF: " + e.what());
+  }
+
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(&gltf_keep_image_bytes, nullptr);
+  loader.SetFsCallbacks({&gltf_fs_exists, &gltf_fs_expand, &gltf_fs_read, &gltf_fs_write, &fs});
+  tinygltf::Model& model = doc->model;
+  std::string err, warn;
+  bool ok = false;
+  try {
+    ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), static_cast<unsigned>(bytes.size()), "")
+                : loader.LoadASCIIFromString(&model, &err, &warn, json_text.c_str(),
+                                             static_cast<unsigned>(json_text.size()), "");
+  } catch (const std::exception& e) {
+    ok = false;
+    err += e.what();
+  }
+  if (!ok) {
+    while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
+    return Status::error(StatusCode::ParseError, name + ": invalid glTF: " + (err.empty() ? "unknown error" : err));
+  }
+  if (!warn.empty()) asset->warnings.push_back(warn);
+  doc->image_files.resize(model.images.size());
+
+  // Roots: the default scene, scene 0, or (no scenes) every node that is nobody's child.
+  std::vector<int> roots;
+  if (!model.scenes.empty()) {
+    const int scene = model.defaultScene >= 0 && model.defaultScene < static_cast<int>(model.scenes.size())
+                          ? model.defaultScene
+                          : 0;
+    roots = model.scenes[scene].nodes;
+  } else {
+    std::vector<char> is_child(model.nodes.size(), 0);
+    for (const tinygltf::Node& n : model.nodes)
+      for (int c : n.children)
+        if (c >= 0 && c < static_cast<int>(model.nodes.size())) is_child[c] = 1;
+    for (size_t i = 0; i < model.nodes.size(); ++i)
+      if (!is_child[i]) roots.push_back(static_cast<int>(i));
+  }
+
+  std::vector<Eigen::RowVector3d> positions;
+  std::vector<Eigen::RowVector3i> triangles;
+  std::vector<char> visited(model.nodes.size(), 0);
+  // Depth-first in scene order; an explicit stack keeps deep hierarchies off the call stack.
+  struct Item { int node; Eigen::Matrix4d parent; };
+  std::vector<Item> stack;
+  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, Eigen::Matrix4d::Identity()});
+  int skipped = 0;
+  while (!stack.empty()) {
+    const Item item = stack.back();
+    stack.pop_back();
+    if (item.node < 0 || item.node >= static_cast<int>(model.nodes.size()))
+      return Status::error(StatusCode::ParseError, name + ": node " + std::to_string(item.node) + " does not exist");
+    if (visited[item.node])
+      return Status::error(StatusCode::ParseError, name + ": node " + std::to_string(item.node) +
+                                                       " is reached twice (the node hierarchy must be a tree)");
+    visited[item.node] = 1;
+    const tinygltf::Node& node = model.nodes[item.node];
+    const Eigen::Matrix4d world = item.parent * gltf_node_local(node);
+    for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back({*c, world});
+    if (node.mesh < 0) continue;
+    if (node.mesh >= static_cast<int>(model.meshes.size()))
+      return Status::error(StatusCode::ParseError, name + ": node " + std::to_string(item.node) +
+                                                       " refers to missing mesh " + std::to_string(node.mesh));
+    const tinygltf::Mesh& mesh = model.meshes[node.mesh];
+    for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
+      const tinygltf::Primitive& prim = mesh.primitives[pi];
+      const std::string label = "mesh " + std::to_string(node.mesh) + (mesh.name.empty() ? "" : " ('" + mesh.name + "')") +
+                                " primitive " + std::to_string(pi);
+      if (prim.mode != TINYGLTF_MODE_TRIANGLES) {
+        if (!opt.skip_unsupported_primitives)
+          return Status::error(StatusCode::Unsupported,
+                               name + ": " + label + " uses mode " + gltf_mode_name(prim.mode) +
+                                   "; only TRIANGLES primitives are supported (load with "
+                                   "skip_unsupported_primitives to ignore it)");
+        ++skipped;
+        continue;
+      }
+      const auto pos_it = prim.attributes.find("POSITION");
+      if (pos_it == prim.attributes.end()) {
+        asset->warnings.push_back(label + " has no POSITION attribute and was skipped");
+        continue;
+      }
+      Eigen::MatrixXd P;
+      Status s = read_gltf_accessor(model, pos_it->second, &P);
+      if (!s.ok()) return Status::error(s.code, name + ": " + label + " POSITION: " + s.message);
+      if (P.cols() != 3)
+        return Status::error(StatusCode::ParseError, name + ": " + label + " POSITION is not VEC3");
+      const int nv = static_cast<int>(P.rows());
+      Eigen::MatrixXd I;
+      if (prim.indices >= 0) {
+        s = read_gltf_accessor(model, prim.indices, &I);
+        if (!s.ok()) return Status::error(s.code, name + ": " + label + " indices: " + s.message);
+        const int ct = model.accessors[prim.indices].componentType;
+        if (I.cols() != 1 || (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                               ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+          return Status::error(StatusCode::ParseError, name + ": " + label + " indices must be unsigned integer scalars");
+      } else {
+        I.resize(nv, 1);
+        for (int k = 0; k < nv; ++k) I(k, 0) = k;
+      }
+      if (I.rows() % 3 != 0)
+        return Status::error(StatusCode::ParseError, name + ": " + label + " has " + std::to_string(I.rows()) +
+                                                         " indices, not a multiple of 3");
+      for (Eigen::Index k = 0; k < I.rows(); ++k)
+        if (I(k, 0) >= nv)
+          return Status::error(StatusCode::ParseError, name + ": " + label + " index " + std::to_string(k) + " is " +
+                                                           std::to_string(static_cast<long long>(I(k, 0))) +
+                                                           " but POSITION has only " + std::to_string(nv) + " vertices");
+      PrimitiveRef ref;
+      ref.node = item.node;
+      ref.mesh = node.mesh;
+      ref.primitive = static_cast<int>(pi);
+      ref.first_vertex = static_cast<int>(positions.size());
+      ref.num_vertices = nv;
+      ref.first_face = static_cast<int>(triangles.size());
+      ref.num_faces = static_cast<int>(I.rows() / 3);
+      ref.skinned = node.skin >= 0;
+      ref.world = world;
+      ref.name = node.name + "/" + mesh.name + "#" + std::to_string(pi);
+      for (int v = 0; v < nv; ++v) {
+        const Eigen::Vector4d p = world * Eigen::Vector4d(P(v, 0), P(v, 1), P(v, 2), 1.0);
+        positions.emplace_back(p.x(), p.y(), p.z());
+      }
+      for (int f = 0; f < ref.num_faces; ++f)
+        triangles.emplace_back(ref.first_vertex + static_cast<int>(I(3 * f, 0)),
+                               ref.first_vertex + static_cast<int>(I(3 * f + 1, 0)),
+                               ref.first_vertex + static_cast<int>(I(3 * f + 2, 0)));
+      asset->primitives.push_back(ref);
+    }
+  }
+  if (skipped > 0)
+    asset->warnings.push_back(std::to_string(skipped) + " non-triangle primitive(s) were skipped and are kept unchanged");
+  if (asset->primitives.empty())
+    return Status::error(StatusCode::InvalidMesh, name + ": the scene has no triangle mesh primitives");
+  asset->V_raw.resize(static_cast<Eigen::Index>(positions.size()), 3);
+  for (size_t i = 0; i < positions.size(); ++i) asset->V_raw.row(static_cast<Eigen::Index>(i)) = positions[i];
+  asset->F_raw.resize(static_cast<Eigen::Index>(triangles.size()), 3);
+  for (size_t i = 0; i < triangles.size(); ++i) asset->F_raw.row(static_cast<Eigen::Index>(i)) = triangles[i];
+  asset->document = std::move(doc);
+  return Status::success();
+}
+
+}  // namespace mm::io

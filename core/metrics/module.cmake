@@ -1,0 +1,1 @@
+list(APPEND MM_CORE_SOURCES core/metrics/edit_metrics.cpp)

@@ -1,0 +1,100 @@
+#include "retarget/harmonic_map.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/SVD>
+
+#include "mesh/mesh.h"
+#include "retarget/mfs_kernel.h"
+#include "spatial/triangle_bvh.h"
+
+namespace mm {
+
+SingularityResult singularity_points(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                     const SingularityOptions& opt) {
+  SingularityResult r;
+  const double diag = bounding_box_diagonal(V);
+  if (V.rows() == 0 || F.rows() == 0 || !(diag > 0)) {
+    r.status = Status::error(StatusCode::InvalidMesh, "cannot place singularity points: the surface is empty");
+    return r;
+  }
+  const TriangleBvh bvh(V, F);
+  const SurfaceSamples S = surface_samples(V, F, opt.candidates);
+  // Spread the candidate seeds first so that the work does not depend on the mesh density.
+  const std::vector<int> seeds = farthest_point_sampling(S.P, opt.candidates, 0);
+  std::vector<Eigen::Vector3d> cand;
+  std::vector<double> clearance;
+  cand.reserve(2 * seeds.size());
+  for (int s : seeds) {
+    const Eigen::Vector3d p = S.P.row(s).transpose(), n = S.N.row(s).transpose();
+    if (!(n.squaredNorm() > 0)) continue;
+    for (double side : {1.0, -1.0}) {
+      // The largest offset that fits on this side: thin gaps get smaller offsets instead of none.
+      double o = opt.offset * diag;
+      for (int level = 0; level <= opt.offset_levels; ++level, o *= 0.5) {
+        const Eigen::Vector3d c = p + side * o * n;
+        const ClosestPoint cp = bvh.closest_point(c);
+        if (cp.sq_distance < 0.64 * o * o) continue;
+        if (bvh.inside(c)) break;  // a smaller offset on the same side is inside as well
+        cand.push_back(c);
+        clearance.push_back(std::sqrt(cp.sq_distance));
+        break;
+      }
+    }
+  }
+  if (cand.empty()) {
+    r.status = Status::error(StatusCode::InvalidMesh,
+                             "cannot place singularity points: no offset point lies outside the surface");
+    return r;
+  }
+  Eigen::MatrixXd C(cand.size(), 3);
+  for (size_t i = 0; i < cand.size(); ++i) C.row(i) = cand[i].transpose();
+  const std::vector<int> pick = farthest_point_sampling(C, opt.count, 0);
+  r.Q.resize(pick.size(), 3);
+  r.min_clearance = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < pick.size(); ++i) {
+    r.Q.row(i) = C.row(pick[i]);
+    r.min_clearance = std::min(r.min_clearance, clearance[pick[i]]);
+  }
+  return r;
+}
+
+Status MfsHarmonicMap::build(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                             const HarmonicMapOptions& opt, const Progress& progress) {
+  if (!progress.update("singularities", 0)) return cancelled_status("singularities");
+  SingularityResult sr = singularity_points(V, F, opt.singularities);
+  if (!sr.status.ok()) return sr.status;
+  Q_ = std::move(sr.Q);
+  if (!progress.update("collocation", 0.3)) return cancelled_status("collocation");
+  const SurfaceSamples all = surface_samples(V, F, 4 * opt.num_collocation);
+  colloc_ = select_samples(all, farthest_point_sampling(all.P, opt.num_collocation, 0));
+  F_ = F;
+  if (colloc_.size() < Q_.rows())
+    return Status::error(StatusCode::InvalidMesh,
+                         "the surface is too small for the MFS fit: " + std::to_string(colloc_.size()) +
+                             " collocation points for " + std::to_string(Q_.rows()) + " singularity points");
+  if (!progress.update("svd", 0.5)) return cancelled_status("svd");
+  const Eigen::MatrixXd As = mfs_kernel(colloc_.P, Q_);  // N_c by N_a, Eq. 3
+  // Sec. 7.1: As = U S Vᵀ, As⁺ = V S⁻¹ Uᵀ with small singular values dropped (truncated SVD):
+  // plain inversion of the tiny ones amplifies noise into huge, oscillating coefficients.
+  Eigen::BDCSVD<Eigen::MatrixXd> svd(As, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const Eigen::VectorXd& sv = svd.singularValues();
+  if (sv.size() == 0 || !(sv[0] > 0) || !std::isfinite(sv[0]))
+    return Status::error(StatusCode::NumericalError, "the MFS collocation matrix is zero or not finite");
+  condition_ = sv[0] / sv[sv.size() - 1];
+  const double cut = opt.svd_truncation * sv[0];
+  rank_ = 0;
+  while (rank_ < sv.size() && sv[rank_] > cut) ++rank_;
+  const Eigen::VectorXd inv = sv.head(rank_).cwiseInverse();
+  pinv_ = svd.matrixV().leftCols(rank_) * inv.asDiagonal() * svd.matrixU().leftCols(rank_).transpose();
+  if (!pinv_.allFinite()) return Status::error(StatusCode::NumericalError, "MFS pseudo-inverse is not finite");
+  progress.update("svd", 1);
+  return Status::success();
+}
+
+Eigen::MatrixXd MfsHarmonicMap::fit(const Eigen::MatrixXd& V_deformed) const {
+  return pinv_ * colloc_.positions(V_deformed, F_);
+}
+
+}  // namespace mm

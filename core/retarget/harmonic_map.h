@@ -1,0 +1,81 @@
+// MFS harmonic map of a calibration shape (paper 002 Sec. 4, 7.1): singularity points on an
+// offset surface outside the shape, collocation points on the surface, and the pseudo-inverse
+// of the collocation matrix As (Eq. 3), computed once by SVD so that fitting a deformed pose
+// is one matrix product, Ws = As⁺ bs (Eq. 13).
+//
+// Meshless: V/F may be a polygon soup, several parts, non-manifold or open; only closest
+// points, inside tests (spatial/triangle_bvh.h) and surface samples are used.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "common/progress.h"
+#include "common/status.h"
+#include "spatial/farthest_point_sampling.h"
+
+namespace mm {
+
+struct SingularityOptions {
+  int count = 260;           // N_a singularity points (paper Sec. 4.3: "260 on average")
+  double offset = 0.04;      // offset-surface distance, fraction of the bbox diagonal of V
+  int offset_levels = 3;     // where the full offset does not fit (gaps between legs, armpits),
+                             // offset/2, offset/4, ... are tried, down to this many halvings
+  int candidates = 3000;     // surface samples turned into offset candidates before FPS
+};
+
+struct SingularityResult {
+  Status status;             // InvalidMesh when no candidate lies outside the surface
+  Eigen::MatrixXd Q;         // N_a by 3 singularity points (fewer when candidates ran out)
+  double min_clearance = 0;  // smallest distance from a singularity to the surface
+};
+
+// Offset candidates s ± o·n (both sides: the surface may be open, single-sided or inverted)
+// kept when they are outside the shape and at least 0.8·o away from the surface, then
+// N_a of them by farthest-point sampling (paper Sec. 4.3 uses a progressive hull; an offset
+// sampled this way is what Sec. 2.4 calls "offset points close to the boundary surface").
+SingularityResult singularity_points(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                     const SingularityOptions& opt = {});
+
+struct HarmonicMapOptions {
+  SingularityOptions singularities;
+  int num_collocation = 1500;   // N_c collocation points (FPS over surface samples); N_c ≫ N_a
+                                // makes Eq. 3 an over-determined least-squares fit
+  double svd_truncation = 1e-9; // singular values of As below this × σ_max are dropped in As⁺
+                                // (Sec. 7.1): MFS matrices are ill-conditioned (cond ~1e10 here);
+                                // the truncation keeps fitted coefficients bounded while the
+                                // collocation residual stays below 1e-4 of the size (tests)
+};
+
+class MfsHarmonicMap {
+ public:
+  // Samples singularity and collocation points on (V, F) and factors As by SVD.
+  // Progress stages: "singularities", "collocation", "svd".
+  Status build(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const HarmonicMapOptions& opt = {},
+               const Progress& progress = {});
+
+  // Ws (N_a by 3) such that K(P) Ws ≈ the collocation points of the deformed surface
+  // V_deformed (same vertex layout and F as at build). Eq. 13.
+  Eigen::MatrixXd fit(const Eigen::MatrixXd& V_deformed) const;
+  // Collocation points (N_c by 3) of a deformed copy of the surface: bs of Eq. 3.
+  Eigen::MatrixXd collocation_positions(const Eigen::MatrixXd& V_deformed) const {
+    return colloc_.positions(V_deformed, F_);
+  }
+  // The same from the deformed collocation positions (N_c by 3) directly.
+  Eigen::MatrixXd fit_collocation(const Eigen::MatrixXd& B) const { return pinv_ * B; }
+
+  const Eigen::MatrixXd& singularities() const { return Q_; }   // N_a by 3
+  const SurfaceSamples& collocation() const { return colloc_; }  // N_c samples
+  int rank() const { return rank_; }                             // kept singular values
+  double condition() const { return condition_; }                // σ_max / σ_min of As
+  int num_singularities() const { return static_cast<int>(Q_.rows()); }
+
+ private:
+  Eigen::MatrixXd Q_;
+  SurfaceSamples colloc_;
+  Eigen::MatrixXi F_;
+  Eigen::MatrixXd pinv_;  // N_a by N_c
+  int rank_ = 0;
+  double condition_ = 0;
+};
+
+}  // namespace mm

@@ -1,0 +1,307 @@
+#include "retarget/harmonic_retarget.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/SVD>
+
+#include "mesh/mesh.h"
+#include "retarget/mfs_kernel.h"
+#include "spatial/triangle_bvh.h"
+
+namespace mm {
+
+namespace retarget_detail {
+
+Eigen::RowVector3d bbox_center(const Eigen::MatrixXd& V) {
+  return 0.5 * (V.colwise().minCoeff() + V.colwise().maxCoeff());
+}
+
+// Rotation R with R·t ≈ s for centred point sets (Kabsch), snapped to the nearest of the 24
+// axis-aligned rotations: files differ by axis conventions (Y-up vs Z-up, facing ±X/±Z), while
+// a general rotation fitted to joints of differently shaped characters would be noise (a walk
+// would come out slightly sideways). Identity when the joints do not fix a rotation.
+Eigen::Matrix3d snapped_alignment(const Eigen::MatrixXd& S, const Eigen::MatrixXd& T) {
+  if (S.rows() < 3) return Eigen::Matrix3d::Identity();
+  const Eigen::MatrixXd Sc = S.rowwise() - S.colwise().mean();
+  const Eigen::MatrixXd Tc = T.rowwise() - T.colwise().mean();
+  const Eigen::Matrix3d H = Tc.transpose() * Sc;  // Σ t sᵀ
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  if (!(svd.singularValues()[1] > 1e-6 * svd.singularValues()[0])) return Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d Rk = svd.matrixV() * svd.matrixU().transpose();
+  if (Rk.determinant() < 0) {
+    Eigen::Matrix3d Vm = svd.matrixV();
+    Vm.col(2) *= -1;
+    Rk = Vm * svd.matrixU().transpose();
+  }
+  Eigen::Matrix3d best = Eigen::Matrix3d::Identity();
+  double best_score = -1e300;
+  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (const auto& p : perms)
+    for (int signs = 0; signs < 8; ++signs) {
+      Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+      for (int r = 0; r < 3; ++r) C(r, p[r]) = (signs >> r & 1) ? -1.0 : 1.0;
+      if (C.determinant() < 0) continue;
+      const double score = (C.transpose() * Rk).trace();
+      if (score > best_score + 1e-12) {
+        best_score = score;
+        best = C;
+      }
+    }
+  return best;
+}
+
+Eigen::MatrixXd to_working(const Eigen::MatrixXd& V, const Eigen::RowVector3d& c, double L, const Eigen::Matrix3d& R) {
+  return ((V.rowwise() - c) / L) * R.transpose();
+}
+
+}  // namespace retarget_detail
+
+Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const RetargetCharacter& target,
+                                      const std::map<std::string, std::string>& source_to_target,
+                                      const HarmonicRetargetOptions& opt, const Progress& progress) {
+  using namespace retarget_detail;
+  ready_ = false;
+  opt_ = opt;
+  warnings_.clear();
+  used_.clear();
+  bones_.clear();
+  bone_desc_.clear();
+  for (const auto* c : {&source, &target}) {
+    const char* side = c == &source ? "source" : "target";
+    if (c->V.rows() == 0 || c->F.rows() == 0)
+      return Status::error(StatusCode::InvalidMesh, std::string("the ") + side + " surface is empty");
+    if (!c->V.allFinite())
+      return Status::error(StatusCode::InvalidMesh, std::string("the ") + side + " surface has non-finite coordinates");
+    if (c->F.minCoeff() < 0 || c->F.maxCoeff() >= c->V.rows())
+      return Status::error(StatusCode::InvalidMesh, std::string("the ") + side + " faces index missing vertices");
+    if (c->joints.size() == 0)
+      return Status::error(StatusCode::InvalidArgument,
+                           std::string("the ") + side + " has no joints" +
+                               (c == &target ? " (give the target's joints as a JSON file {\"name\": [x, y, z]})" : ""));
+    if (c->joints.P.rows() != c->joints.size() || !c->joints.P.allFinite())
+      return Status::error(StatusCode::InvalidArgument, std::string("the ") + side + " joint positions are invalid");
+  }
+  JointMatchResult match = match_joints(source.joints, target.joints, source_to_target, 2);
+  if (!match.status.ok()) return match.status;
+  for (auto& w : match.warnings) warnings_.push_back(w);
+
+  // Working frames.
+  cs_ = bbox_center(source.V);
+  ct_ = bbox_center(target.V);
+  Ls_ = bounding_box_diagonal(source.V);
+  Lt_ = bounding_box_diagonal(target.V);
+  {
+    Eigen::MatrixXd S(match.pairs.size(), 3), T(match.pairs.size(), 3);
+    for (size_t i = 0; i < match.pairs.size(); ++i) {
+      S.row(i) = source.joints.P.row(match.pairs[i].source);
+      T.row(i) = target.joints.P.row(match.pairs[i].target);
+    }
+    R_ = opt.align_axes ? snapped_alignment(S, T) : Eigen::Matrix3d::Identity();
+  }
+  const Eigen::MatrixXd Xs = to_working(source.V, cs_, Ls_, Eigen::Matrix3d::Identity());
+  const Eigen::MatrixXd Xt = to_working(target.V, ct_, Lt_, R_);
+  const Eigen::MatrixXd JsAll = to_working(source.joints.P, cs_, Ls_, Eigen::Matrix3d::Identity());
+  const Eigen::MatrixXd JtAll = to_working(target.joints.P, ct_, Lt_, R_);
+
+  // Inside/outside classification of joints.
+  const TriangleBvh bvh_s(Xs, source.F), bvh_t(Xt, target.F);
+  const double tol2 = opt.joint_tolerance * opt.joint_tolerance;  // working units: diagonal 1
+  auto is_inside = [&](const TriangleBvh& bvh, const Eigen::Vector3d& p) {
+    return bvh.closest_point(p).sq_distance <= tol2 || bvh.inside(p);
+  };
+  for (const JointPair& jp : match.pairs) {
+    const std::string& name = source.joints.names[jp.source];
+    if (!is_inside(bvh_s, JsAll.row(jp.source).transpose())) {
+      warnings_.push_back("source joint '" + name + "' lies outside the source surface and is not used");
+      continue;
+    }
+    const Eigen::Vector3d pt = JtAll.row(jp.target).transpose();
+    if (!is_inside(bvh_t, pt)) {
+      const double d = std::sqrt(bvh_t.closest_point(pt).sq_distance);
+      const std::string msg = "target joint '" + target.joints.names[jp.target] + "' lies outside the target surface (" +
+                              std::to_string(d * 100).substr(0, 5) + "% of the target size away)";
+      if (target.joints.from_user) return Status::error(StatusCode::InvalidArgument, msg + "; move it inside the mesh");
+      warnings_.push_back(msg + " and is not used");
+      continue;
+    }
+    used_.push_back(jp);
+  }
+  if (used_.size() < 2)
+    return Status::error(StatusCode::InvalidArgument,
+                         "fewer than 2 matched joints lie inside both surfaces (" + std::to_string(used_.size()) + ")");
+  const int m = static_cast<int>(used_.size());
+  Js_rest_.resize(m, 3);
+  Jt_rest_.resize(m, 3);
+  for (int i = 0; i < m; ++i) {
+    Js_rest_.row(i) = JsAll.row(used_[i].source);
+    Jt_rest_.row(i) = JtAll.row(used_[i].target);
+  }
+
+  // Bones: each used joint to its nearest used ancestor in the source hierarchy.
+  const bool has_tree = static_cast<int>(source.joints.parent.size()) == source.joints.size();
+  if (!has_tree) warnings_.push_back("the source joints have no hierarchy: no bone-length term");
+  std::vector<int> used_of(source.joints.size(), -1);
+  for (int i = 0; i < m; ++i) used_of[used_[i].source] = i;
+  if (has_tree)
+    for (int i = 0; i < m; ++i) {
+      int p = source.joints.parent[used_[i].source];
+      for (int guard = 0; p >= 0 && used_of[p] < 0 && guard <= source.joints.size(); ++guard) p = source.joints.parent[p];
+      if (p >= 0 && used_of[p] >= 0 && (Jt_rest_.row(i) - Jt_rest_.row(used_of[p])).norm() > 1e-6)
+        bones_.push_back({i, used_of[p]});
+    }
+
+  // Anchor joint for E_position.
+  const std::vector<int> depth = joint_depths(source.joints);
+  anchor_ = -1;
+  if (!opt.anchor_joint.empty()) {
+    for (int i = 0; i < m; ++i)
+      if (source.joints.names[used_[i].source] == opt.anchor_joint) anchor_ = i;
+    if (anchor_ < 0)
+      return Status::error(StatusCode::InvalidArgument,
+                           "anchor joint '" + opt.anchor_joint + "' is not a matched joint inside both surfaces");
+  } else {
+    for (int i = 0; i < m; ++i)
+      if (anchor_ < 0 || depth[used_[i].source] < depth[used_[anchor_].source]) anchor_ = i;
+  }
+  {
+    const int up = std::clamp(opt.up_axis, 0, 2);
+    const double hs = Js_rest_(anchor_, up) - Xs.col(up).minCoeff();
+    const double ht = Jt_rest_(anchor_, up) - Xt.col(up).minCoeff();
+    scale_ = (hs > 0.02 && ht > 0.02) ? ht / hs : 1.0;
+  }
+
+  // Descriptor points: joints, then bone-interior samples kept where inside both shapes.
+  std::vector<Eigen::RowVector3d> ds, dt;
+  for (int i = 0; i < m; ++i) {
+    ds.push_back(Js_rest_.row(i));
+    dt.push_back(Jt_rest_.row(i));
+  }
+  for (const auto& [c, p] : bones_) {
+    bone_desc_.push_back({c, p});
+    for (int k = 1; k <= opt.bone_samples; ++k) {
+      const double a = double(k) / (opt.bone_samples + 1);
+      const Eigen::RowVector3d xs = (1 - a) * Js_rest_.row(c) + a * Js_rest_.row(p);
+      const Eigen::RowVector3d xt = (1 - a) * Jt_rest_.row(c) + a * Jt_rest_.row(p);
+      if (is_inside(bvh_s, xs.transpose()) && is_inside(bvh_t, xt.transpose())) {
+        ds.push_back(xs);
+        dt.push_back(xt);
+      }
+    }
+  }
+  Xs_desc_.resize(ds.size(), 3);
+  Xt_desc_.resize(dt.size(), 3);
+  for (size_t i = 0; i < ds.size(); ++i) {
+    Xs_desc_.row(i) = ds[i];
+    Xt_desc_.row(i) = dt[i];
+  }
+
+  // MFS bases.
+  Status s = src_map_.build(Xs, source.F, opt.map, progress.sub(0.0, 0.4));
+  if (!s.ok()) return Status{s.code, "source: " + s.message};
+  s = tgt_map_.build(Xt, target.F, opt.map, progress.sub(0.4, 0.8));
+  if (!s.ok()) return Status{s.code, "target: " + s.message};
+  if (!progress.update("synthesis", 0.8)) return cancelled_status("synthesis");
+  const Eigen::MatrixXd& Q = src_map_.singularities();
+  const Eigen::MatrixXd& U = tgt_map_.singularities();
+  Ds_desc_ = mfs_gradient(Xs_desc_, Q);
+  Ks_joints_ = mfs_kernel(Js_rest_, Q);
+  As_ = mfs_kernel(src_map_.collocation().P, Q);
+  Kt_joints_ = mfs_kernel(Jt_rest_, U);
+  Kt_all_ = mfs_kernel(Xt, U);
+
+  synth_ = HarmonicSynthesis();
+  const int nd = static_cast<int>(Xt_desc_.rows());
+  term_affine_ = synth_.add_term({"affine", mfs_gradient(Xt_desc_, U), opt.w_affine / nd, false});
+  term_position_ = synth_.add_term({"position", Kt_joints_.row(anchor_), opt.w_position, false});
+  rest_len_.resize(bones_.size());
+  rest_len_world_.resize(bones_.size());
+  if (!bones_.empty()) {
+    Eigen::MatrixXd Ab(bones_.size(), U.rows());
+    for (size_t b = 0; b < bones_.size(); ++b) {
+      const auto [c, p] = bones_[b];
+      rest_len_[b] = (Jt_rest_.row(c) - Jt_rest_.row(p)).norm();
+      rest_len_world_[b] = rest_len_[b] * Lt_;
+      Ab.row(b) = (Kt_joints_.row(c) - Kt_joints_.row(p)) / rest_len_[b];
+    }
+    term_bone_ = synth_.add_term({"bone", Ab, opt.w_bone / bones_.size(), false});
+  } else {
+    term_bone_ = -1;
+  }
+  {
+    const SurfaceSamples& C = tgt_map_.collocation();
+    const int nh = std::min(opt.num_smooth_points, C.size());
+    // Collocation points are already in FPS order, so a prefix is a well-spread subset.
+    synth_.add_term({"smooth", mfs_hessian(C.P.topRows(nh), U), opt.w_smooth / std::max(1, nh), true});
+  }
+  s = synth_.factor(opt.ridge);
+  if (!s.ok()) return s;
+  progress.update("synthesis", 1.0);
+  ready_ = true;
+  return Status::success();
+}
+
+RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) const {
+  RetargetFrame out;
+  if (!ready_) {
+    out.status = Status::error(StatusCode::InvalidArgument, "retarget called before a successful precompute");
+    return out;
+  }
+  if (V_source.cols() != 3 || !V_source.allFinite()) {
+    out.status = Status::error(StatusCode::InvalidArgument, "source frame must be #V by 3 finite positions");
+    return out;
+  }
+  // Analysis: Ws = As⁺ bs (Eq. 13); Jsᵀ = Ds Ws at every descriptor point (Eq. 4, 14).
+  const Eigen::MatrixXd Xs = retarget_detail::to_working(V_source, cs_, Ls_, Eigen::Matrix3d::Identity());
+  const Eigen::MatrixXd bs = src_map_.collocation_positions(Xs);
+  const Eigen::MatrixXd Ws = src_map_.fit_collocation(bs);
+  out.fit_residual = std::sqrt((As_ * Ws - bs).squaredNorm() / std::max<Eigen::Index>(1, bs.rows()));
+  const Eigen::MatrixXd JsT = Ds_desc_ * Ws;          // 3m by 3, blocks Jᵀ
+  const Eigen::MatrixXd Js_now = Ks_joints_ * Ws;     // f_s at the used source joints
+
+  // E_position: the anchor follows the source anchor's displacement, scaled (leg-length ratio).
+  const Eigen::MatrixXd p_anchor =
+      Jt_rest_.row(anchor_) + scale_ * (Js_now.row(anchor_) - Js_rest_.row(anchor_));
+
+  // E_bone, first linearisation: the rest bone mapped by the mean Jacobian of its two ends.
+  const int nb = static_cast<int>(bones_.size());
+  Eigen::MatrixXd dirs(nb, 3);
+  for (int b = 0; b < nb; ++b) {
+    const auto [c, p] = bones_[b];
+    const Eigen::Matrix3d Jc = JsT.middleRows(3 * c, 3).transpose(), Jp = JsT.middleRows(3 * p, 3).transpose();
+    const Eigen::Vector3d d = 0.5 * (Jc + Jp) * (Jt_rest_.row(c) - Jt_rest_.row(p)).transpose();
+    dirs.row(b) = d.norm() > 0 ? (d / d.norm()).transpose() : Eigen::RowVector3d(Jt_rest_.row(c) - Jt_rest_.row(p)).normalized();
+  }
+  std::vector<const Eigen::MatrixXd*> rhs(synth_.num_terms(), nullptr);
+  rhs[term_affine_] = &JsT;
+  rhs[term_position_] = &p_anchor;
+  if (term_bone_ >= 0) rhs[term_bone_] = &dirs;
+  Eigen::MatrixXd Wt;
+  const int iterations = term_bone_ >= 0 ? 1 + std::max(0, opt_.bone_iterations) : 1;
+  for (int it = 0; it < iterations; ++it) {
+    out.status = synth_.solve(rhs, &Wt);
+    if (!out.status.ok()) return out;
+    if (it + 1 == iterations) break;
+    // Re-linearise Eq. 9 around the current joints: keep each bone's direction, restore its length.
+    const Eigen::MatrixXd Jt_now = Kt_joints_ * Wt;
+    for (int b = 0; b < nb; ++b) {
+      const Eigen::RowVector3d d = Jt_now.row(bones_[b].first) - Jt_now.row(bones_[b].second);
+      if (d.norm() > 1e-12) dirs.row(b) = d / d.norm();
+    }
+  }
+  // Eq. 6: V = Kt Wt for every target vertex, back to target units and axes.
+  const Eigen::MatrixXd Vw = Kt_all_ * Wt;
+  out.V = (Vw * R_) * Lt_;
+  out.V.rowwise() += ct_;
+  out.joints = ((Kt_joints_ * Wt) * R_) * Lt_;
+  out.joints.rowwise() += ct_;
+  out.source_joints = Js_now * Ls_;
+  out.source_joints.rowwise() += cs_;
+  if (!out.V.allFinite()) {
+    out.status = Status::error(StatusCode::NumericalError, "retargeted positions are not finite");
+    out.V.resize(0, 3);
+  }
+  return out;
+}
+
+}  // namespace mm

@@ -1,0 +1,135 @@
+// harmonic_retarget: motion retargeting by harmonic maps (paper 002, Liu et al. MIG 2018,
+// Sec. 3–5, 7). A session: precompute once per (source, target) pair, then one cheap call per
+// source frame.
+//
+// Analysis (Sec. 4): the source calibration surface gets an MFS harmonic map
+// (retarget/harmonic_map.h); each source frame is fitted, Ws = As⁺ bs (Eq. 13), and its
+// Jacobians are read at descriptor points, Jsᵀ = Ds Ws (Eq. 4, 14).
+// Synthesis (Sec. 5, 7.2): the target's coefficients Wt minimise (retarget/harmonic_synthesis.h)
+//   w_affine   Σ_d ‖Dt(x_d) Wt − Js(x_d)ᵀ‖² / #d                 E_affine, Eq. 5
+//   w_position ‖Kt(a) Wt − p(t)‖²                                 E_position, Eq. 8
+//   w_bone     Σ_b ‖(Kt(c_b) − Kt(p_b)) Wt / l_b − d̂_b‖² / #b     E_bone, Eq. 9–10 linearised
+//   w_smooth   Σ_h ‖Hessian(Kt Wt)(y_h)‖² / #h                    E_smooth, Eq. 7
+// and the target pose is V = Kt Wt for every target vertex (Eq. 6).
+//
+// Choices where the paper is silent or self-contradictory (each documented at its option):
+// - Units: both shapes are centred and scaled to a unit bounding-box diagonal; the target is
+//   rotated into the source's axes (rest poses matched by joints, rotation snapped to the 24
+//   axis-aligned ones, so Z-up and Y-up files combine). Energies are means, so weights do not
+//   depend on sample counts.
+// - Weights (Sec. 7.2 lists 0.01, 10, 1, 0.8, 1 for position, smooth, bone, spatial, volume,
+//   while its text says position must be large and smoothness small): we follow the text and
+//   read the list as smooth = 0.01, position = 10 (tests compare both readings).
+// - Position (Eq. 8, "any point, e.g. v1"): the anchor is a joint (default: the shallowest
+//   used joint in the source hierarchy, i.e. the hips/root), and its trajectory is the source
+//   anchor's displacement f_s(a_s) − a_s scaled by the ratio of anchor heights above the
+//   lowest vertex (leg-length ratio), added to the target anchor's rest position.
+// - Bone (Eq. 9): linearised by fixing each bone's direction d̂_b at the previous iterate, so the
+//   matrix stays constant (factored once) and re-linearising only changes B. The first
+//   direction is the rest bone mapped by the mean source Jacobian of its two ends.
+// - Descriptor points: the joints (paper) plus `bone_samples` points inside each bone, which
+//   pins the rotation of long bones (joint Jacobians alone blend the two adjacent bones).
+//
+// Joints: matched by name or map (retarget/joint_set.h). A source joint outside its surface is
+// dropped with a warning (skeletons often have a root on the floor); a target joint outside
+// its surface is an error when the joints were placed by the user, else dropped.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/progress.h"
+#include "common/status.h"
+#include "retarget/harmonic_map.h"
+#include "retarget/harmonic_synthesis.h"
+#include "retarget/joint_set.h"
+
+namespace mm {
+
+// One side of the retargeting at its calibration (rest) pose.
+struct RetargetCharacter {
+  Eigen::MatrixXd V;  // #V by 3 calibration surface (any triangle soup: parts, open, non-manifold)
+  Eigen::MatrixXi F;  // #F by 3
+  JointSet joints;    // calibration joints; the source's hierarchy (parent) defines the bones
+};
+
+struct HarmonicRetargetOptions {
+  HarmonicMapOptions map;       // MFS of both calibration shapes (singularities, collocation, SVD)
+  double w_affine = 1.0;        // λ_affine: Jacobian match at descriptor points (reference weight)
+  double w_position = 10.0;     // λ_position: anchor trajectory; "should be with a large weight"
+  double w_smooth = 0.01;       // λ_smooth: Hessian energy; "should be small, otherwise flattened"
+  double w_bone = 1.0;          // λ_bone: bone-length preservation
+  int bone_iterations = 2;      // re-linearisations of E_bone after the first solve (0 = one solve)
+  int bone_samples = 1;         // descriptor points inside each bone besides its ends (0 = joints only, as in the paper)
+  int num_smooth_points = 600;  // target surface points where E_smooth is evaluated (FPS subset)
+  double ridge = 1e-9;          // Tikhonov ridge on the normal matrix, × its mean diagonal
+  std::string anchor_joint;     // joint for E_position (a source joint name); "" = shallowest used joint
+  int up_axis = 1;              // source up axis (0 x, 1 y, 2 z) for anchor heights; glTF is +Y
+  bool align_axes = true;       // rotate the target into the source's axes (snapped Kabsch on joints)
+  double joint_tolerance = 0.01;// joints within this × bbox diagonal outside the surface count as inside
+};
+
+struct RetargetFrame {
+  Status status;              // NumericalError if the synthesis produced non-finite values
+  Eigen::MatrixXd V;          // #V_target by 3 target positions (target units and axes)
+  Eigen::MatrixXd joints;     // #used joints by 3 target joint positions f_t(J_t)
+  Eigen::MatrixXd source_joints;  // #used joints by 3 source joints mapped by the fit f_s(J_s)
+  double fit_residual = 0;    // RMS collocation residual of the source fit / source bbox diagonal
+};
+
+class HarmonicRetargeter {
+ public:
+  // Samples both MFS bases, factors As (SVD) and the synthesis normal matrix. Progress stages:
+  // "source map", "target map", "synthesis".
+  Status precompute(const RetargetCharacter& source, const RetargetCharacter& target,
+                    const std::map<std::string, std::string>& source_to_target = {},
+                    const HarmonicRetargetOptions& opt = {}, const Progress& progress = {});
+
+  // Target pose for one source frame V_source (same layout as source.V).
+  RetargetFrame retarget(const Eigen::MatrixXd& V_source) const;
+
+  bool ready() const { return ready_; }
+  // Used joint pairs (indices into source/target JointSets) in the order of RetargetFrame::joints.
+  const std::vector<JointPair>& used_joints() const { return used_; }
+  // Bones as (child, parent) indices into used_joints().
+  const std::vector<std::pair<int, int>>& bones() const { return bones_; }
+  const Eigen::VectorXd& rest_bone_lengths() const { return rest_len_world_; }  // target units
+  int anchor() const { return anchor_; }                        // index into used_joints()
+  const Eigen::Matrix3d& alignment() const { return R_; }       // target axes → source axes
+  double anchor_scale() const { return scale_; }                // root-motion scale (target/source)
+  int num_descriptor_points() const { return static_cast<int>(Xs_desc_.rows()); }
+  const MfsHarmonicMap& source_map() const { return src_map_; }
+  const MfsHarmonicMap& target_map() const { return tgt_map_; }
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+ private:
+  bool ready_ = false;
+  HarmonicRetargetOptions opt_;
+  std::vector<std::string> warnings_;
+  std::vector<JointPair> used_;
+  std::vector<std::pair<int, int>> bones_;
+  int anchor_ = 0;
+  double scale_ = 1;
+  // Working frames: x_s' = (x − cs)/Ls, x_t' = R (x − ct)/Lt.
+  Eigen::RowVector3d cs_, ct_;
+  double Ls_ = 1, Lt_ = 1;
+  Eigen::Matrix3d R_ = Eigen::Matrix3d::Identity();
+  MfsHarmonicMap src_map_, tgt_map_;
+  Eigen::MatrixXd Xs_desc_, Xt_desc_;   // descriptor points (working frames)
+  Eigen::MatrixXd Ds_desc_;             // 3m by N_a(source)
+  Eigen::MatrixXd Ks_joints_;           // #used by N_a(source)
+  Eigen::MatrixXd As_;                  // N_c by N_a(source), for the fit residual
+  Eigen::MatrixXd Kt_joints_;           // #used by N_a(target)
+  Eigen::MatrixXd Kt_all_;              // #V_target by N_a(target)
+  Eigen::MatrixXd Js_rest_, Jt_rest_;   // used joints, working frames
+  std::vector<std::pair<int, int>> bone_desc_;  // descriptor indices of each bone's ends
+  Eigen::VectorXd rest_len_;            // target bone lengths, working units
+  Eigen::VectorXd rest_len_world_;
+  HarmonicSynthesis synth_;
+  int term_affine_ = -1, term_position_ = -1, term_bone_ = -1;
+};
+
+}  // namespace mm

@@ -1,0 +1,106 @@
+#include "retarget/lbs_baseline.h"
+
+#include <algorithm>
+#include <map>
+
+#include "mesh/mesh.h"
+#include "spatial/triangle_bvh.h"
+
+namespace mm {
+
+namespace retarget_detail {
+Eigen::Matrix3d snapped_alignment(const Eigen::MatrixXd& S, const Eigen::MatrixXd& T);  // harmonic_retarget.cpp
+}
+
+Eigen::MatrixXd linear_blend_skinning(const Eigen::MatrixXd& V, const SkinWeights& W, const Matrix4dList& M) {
+  Eigen::MatrixXd out(V.rows(), 3);
+  for (int i = 0; i < V.rows(); ++i) {
+    Eigen::Matrix<double, 3, 4> B = Eigen::Matrix<double, 3, 4>::Zero();
+    for (int k = 0; k < W.index.cols(); ++k) {
+      const double w = W.weight(i, k);
+      if (w == 0) continue;
+      B += w * M[W.index(i, k)].topRows<3>();
+    }
+    out.row(i) = (B.leftCols<3>() * V.row(i).transpose() + B.col(3)).transpose();
+  }
+  return out;
+}
+
+Eigen::Matrix4d Similarity::matrix() const {
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  T.topLeftCorner<3, 3>() = s * R;
+  T.topRightCorner<3, 1>() = t;
+  return T;
+}
+
+Eigen::MatrixXd Similarity::apply(const Eigen::MatrixXd& X) const {
+  Eigen::MatrixXd Y = (X * R.transpose()) * s;
+  Y.rowwise() += t.transpose();
+  return Y;
+}
+
+Similarity align_rest_poses(const JointSet& source, const JointSet& target, const std::vector<JointPair>& pairs,
+                            const Eigen::MatrixXd& V_source, const Eigen::MatrixXd& V_target) {
+  Similarity A;
+  const int n = static_cast<int>(pairs.size());
+  if (n >= 3) {
+    Eigen::MatrixXd S(n, 3), T(n, 3);
+    for (int i = 0; i < n; ++i) {
+      S.row(i) = source.P.row(pairs[i].source);
+      T.row(i) = target.P.row(pairs[i].target);
+    }
+    A.R = retarget_detail::snapped_alignment(S, T);
+    const Eigen::RowVector3d ms = S.colwise().mean(), mt = T.colwise().mean();
+    const Eigen::MatrixXd Tr = (T.rowwise() - mt) * A.R.transpose();
+    const Eigen::MatrixXd Sc = S.rowwise() - ms;
+    const double den = Tr.squaredNorm();
+    A.s = den > 0 ? (Tr.cwiseProduct(Sc)).sum() / den : 1.0;
+    if (!(A.s > 0)) A.s = bounding_box_diagonal(V_source) / std::max(1e-300, bounding_box_diagonal(V_target));
+    A.t = (ms - A.s * mt * A.R.transpose()).transpose();
+    return A;
+  }
+  A.s = bounding_box_diagonal(V_source) / std::max(1e-300, bounding_box_diagonal(V_target));
+  const Eigen::RowVector3d cs = V_source.colwise().mean(), ct = V_target.colwise().mean();
+  A.t = (cs - A.s * ct).transpose();
+  return A;
+}
+
+SkinTransferResult transfer_skin_weights(const Eigen::MatrixXd& V_source, const Eigen::MatrixXi& F_source,
+                                         const SkinWeights& sw, const Eigen::MatrixXd& Vt, int K) {
+  SkinTransferResult r;
+  if (V_source.rows() == 0 || F_source.rows() == 0) {
+    r.status = Status::error(StatusCode::InvalidMesh, "skin weight transfer: the source surface is empty");
+    return r;
+  }
+  const TriangleBvh bvh(V_source, F_source);
+  r.weights.index = Eigen::MatrixXi::Zero(Vt.rows(), K);
+  r.weights.weight = Eigen::MatrixXd::Zero(Vt.rows(), K);
+  for (int i = 0; i < Vt.rows(); ++i) {
+    const ClosestPoint cp = bvh.closest_point(Vt.row(i).transpose());
+    std::map<int, double> acc;  // ordered: deterministic ties
+    for (int c = 0; c < 3; ++c) {
+      const int v = F_source(cp.face, c);
+      for (int k = 0; k < sw.index.cols(); ++k)
+        if (sw.weight(v, k) != 0) acc[sw.index(v, k)] += cp.barycentric[c] * sw.weight(v, k);
+    }
+    std::vector<std::pair<double, int>> sorted;
+    for (const auto& [j, w] : acc) sorted.push_back({-w, j});
+    std::stable_sort(sorted.begin(), sorted.end());
+    double total = 0;
+    for (int k = 0; k < K && k < static_cast<int>(sorted.size()); ++k) total += -sorted[k].first;
+    for (int k = 0; k < K && k < static_cast<int>(sorted.size()); ++k) {
+      r.weights.index(i, k) = sorted[k].second;
+      r.weights.weight(i, k) = total > 0 ? -sorted[k].first / total : 0;
+    }
+  }
+  return r;
+}
+
+Eigen::MatrixXd lbs_retarget(const Eigen::MatrixXd& V_target, const Similarity& A, const SkinWeights& W,
+                             const Matrix4dList& M_source) {
+  const Eigen::MatrixXd posed = linear_blend_skinning(A.apply(V_target), W, M_source);
+  // Inverse similarity: x_t = Rᵀ (x_s − t) / s.
+  return ((posed.rowwise() - A.t.transpose()) * A.R) / A.s;
+}
+
+}  // namespace mm

@@ -1,0 +1,56 @@
+#include "retarget/mfs_kernel.h"
+
+#include <cmath>
+
+namespace mm {
+
+namespace retarget_detail {
+constexpr double kInv4Pi = 1.0 / (4.0 * M_PI);
+}
+
+Eigen::MatrixXd mfs_kernel(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Q) {
+  Eigen::MatrixXd K(X.rows(), Q.rows());
+  for (int a = 0; a < Q.rows(); ++a) {
+    const double qx = Q(a, 0), qy = Q(a, 1), qz = Q(a, 2);
+    for (int i = 0; i < X.rows(); ++i) {
+      const double dx = X(i, 0) - qx, dy = X(i, 1) - qy, dz = X(i, 2) - qz;
+      K(i, a) = retarget_detail::kInv4Pi / std::sqrt(dx * dx + dy * dy + dz * dz);
+    }
+  }
+  return K;
+}
+
+Eigen::MatrixXd mfs_gradient(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Q) {
+  Eigen::MatrixXd D(3 * X.rows(), Q.rows());
+  for (int a = 0; a < Q.rows(); ++a)
+    for (int i = 0; i < X.rows(); ++i) {
+      const Eigen::Vector3d d = X.row(i) - Q.row(a);
+      const double r = d.norm();
+      const double c = -retarget_detail::kInv4Pi / (r * r * r);
+      D(3 * i + 0, a) = c * d[0];
+      D(3 * i + 1, a) = c * d[1];
+      D(3 * i + 2, a) = c * d[2];
+    }
+  return D;
+}
+
+Eigen::MatrixXd mfs_hessian(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Q) {
+  Eigen::MatrixXd H(6 * X.rows(), Q.rows());
+  const double s2 = std::sqrt(2.0);
+  for (int a = 0; a < Q.rows(); ++a)
+    for (int i = 0; i < X.rows(); ++i) {
+      const Eigen::Vector3d d = X.row(i) - Q.row(a);
+      const double r2 = d.squaredNorm();
+      const double c = retarget_detail::kInv4Pi / (r2 * std::sqrt(r2));
+      const double t = 3.0 / r2;
+      H(6 * i + 0, a) = c * (t * d[0] * d[0] - 1);
+      H(6 * i + 1, a) = c * (t * d[1] * d[1] - 1);
+      H(6 * i + 2, a) = c * (t * d[2] * d[2] - 1);
+      H(6 * i + 3, a) = s2 * c * t * d[0] * d[1];
+      H(6 * i + 4, a) = s2 * c * t * d[0] * d[2];
+      H(6 * i + 5, a) = s2 * c * t * d[1] * d[2];
+    }
+  return H;
+}
+
+}  // namespace mm

@@ -1,0 +1,8 @@
+list(APPEND MM_CORE_SOURCES
+  core/retarget/mfs_kernel.cpp
+  core/retarget/harmonic_map.cpp
+  core/retarget/joint_set.cpp
+  core/retarget/harmonic_synthesis.cpp
+  core/retarget/harmonic_retarget.cpp
+  core/retarget/lbs_baseline.cpp)
+list(APPEND MM_TEST_SOURCES tests/retarget_test.cpp)

@@ -1,0 +1,2 @@
+list(APPEND MM_CORE_SOURCES core/spatial/triangle_bvh.cpp core/spatial/farthest_point_sampling.cpp)
+list(APPEND MM_TEST_SOURCES tests/spatial_test.cpp)

@@ -1,0 +1,291 @@
+#include "spatial/triangle_bvh.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mm {
+
+namespace spatial_detail {
+
+constexpr int kLeafSize = 4;
+
+double box_sq_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const Eigen::Vector3d d = (lo - p).cwiseMax(p - hi).cwiseMax(0.0);
+  return d.squaredNorm();
+}
+
+// Slab test of the ray/segment p + s·dir, s in [0, smax], against a box.
+bool ray_hits_box(const Eigen::Vector3d& p, const Eigen::Vector3d& inv_dir, double smax,
+                  const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  double t0 = 0.0, t1 = smax;
+  for (int k = 0; k < 3; ++k) {
+    double a = (lo[k] - p[k]) * inv_dir[k];
+    double b = (hi[k] - p[k]) * inv_dir[k];
+    if (a > b) std::swap(a, b);
+    // NaN (0·inf when the ray lies in the slab plane) compares false and keeps the bound.
+    if (a > t0) t0 = a;
+    if (b < t1) t1 = b;
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+// Möller–Trumbore; returns the ray parameter s (> eps) or -1. `det_sign` gets the sign of
+// dot(normal, dir) where normal = (b-a)x(c-a).
+double ray_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& dir, const Eigen::Vector3d& a,
+                    const Eigen::Vector3d& b, const Eigen::Vector3d& c, int* det_sign) {
+  const Eigen::Vector3d e1 = b - a, e2 = c - a;
+  const Eigen::Vector3d h = dir.cross(e2);
+  const double det = e1.dot(h);
+  const double scale = e1.norm() * e2.norm() * dir.norm();
+  if (std::abs(det) <= 1e-14 * scale) return -1;  // parallel or degenerate triangle
+  const double inv = 1.0 / det;
+  const Eigen::Vector3d s = p - a;
+  const double u = s.dot(h) * inv;
+  if (u < 0.0 || u > 1.0) return -1;
+  const Eigen::Vector3d q = s.cross(e1);
+  const double v = dir.dot(q) * inv;
+  if (v < 0.0 || u + v > 1.0) return -1;
+  const double t = e2.dot(q) * inv;
+  // det = e1·(dir×e2) = dir·(e2×e1) = -dir·n, so the sign is flipped for dot(n, dir).
+  *det_sign = det > 0 ? -1 : 1;
+  return t;
+}
+
+}  // namespace spatial_detail
+
+Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                          const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                                          Eigen::Vector3d* bary) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) { *bary = {1, 0, 0}; return a; }
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) { *bary = {0, 1, 0}; return b; }
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const double v = d1 / (d1 - d3);
+    *bary = {1 - v, v, 0};
+    return a + v * ab;
+  }
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) { *bary = {0, 0, 1}; return c; }
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    const double w = d2 / (d2 - d6);
+    *bary = {1 - w, 0, w};
+    return a + w * ac;
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    *bary = {0, 1 - w, w};
+    return b + w * (c - b);
+  }
+  const double denom = va + vb + vc;
+  if (!(std::abs(denom) > 0)) {  // degenerate triangle: fall back to the nearest corner
+    const double da = ap.squaredNorm(), db = bp.squaredNorm(), dc = cp.squaredNorm();
+    if (da <= db && da <= dc) { *bary = {1, 0, 0}; return a; }
+    if (db <= dc) { *bary = {0, 1, 0}; return b; }
+    *bary = {0, 0, 1};
+    return c;
+  }
+  const double v = vb / denom, w = vc / denom;
+  *bary = {1 - v - w, v, w};
+  return a + ab * v + ac * w;
+}
+
+void TriangleBvh::build(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  V_ = V;
+  F_ = F;
+  nodes_.clear();
+  order_.resize(F.rows());
+  if (F.rows() == 0) return;
+  std::vector<Eigen::Vector3d> centroids(F.rows());
+  for (int f = 0; f < F.rows(); ++f) {
+    order_[f] = f;
+    centroids[f] = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))).transpose() / 3.0;
+  }
+  nodes_.reserve(2 * F.rows() / spatial_detail::kLeafSize + 2);
+  build_node(0, static_cast<int>(F.rows()), centroids);
+}
+
+int TriangleBvh::build_node(int first, int count, std::vector<Eigen::Vector3d>& centroids) {
+  Node node;
+  node.lo.setConstant(std::numeric_limits<double>::infinity());
+  node.hi.setConstant(-std::numeric_limits<double>::infinity());
+  for (int i = first; i < first + count; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d v = V_.row(F_(order_[i], k)).transpose();
+      node.lo = node.lo.cwiseMin(v);
+      node.hi = node.hi.cwiseMax(v);
+    }
+  const int id = static_cast<int>(nodes_.size());
+  nodes_.push_back(node);
+  if (count <= spatial_detail::kLeafSize) {
+    nodes_[id].first = first;
+    nodes_[id].count = count;
+    return id;
+  }
+  Eigen::Vector3d clo = centroids[order_[first]], chi = clo;
+  for (int i = first; i < first + count; ++i) {
+    clo = clo.cwiseMin(centroids[order_[i]]);
+    chi = chi.cwiseMax(centroids[order_[i]]);
+  }
+  int axis = 0;
+  (chi - clo).maxCoeff(&axis);
+  const int mid = first + count / 2;
+  // Ties broken by triangle index keep the tree independent of std::nth_element internals.
+  std::nth_element(order_.begin() + first, order_.begin() + mid, order_.begin() + first + count,
+                   [&](int a, int b) {
+                     const double ca = centroids[a][axis], cb = centroids[b][axis];
+                     return ca < cb || (ca == cb && a < b);
+                   });
+  const int left = build_node(first, mid - first, centroids);
+  const int right = build_node(mid, first + count - mid, centroids);
+  nodes_[id].left = left;
+  nodes_[id].right = right;
+  return id;
+}
+
+ClosestPoint TriangleBvh::closest_point(const Eigen::Vector3d& p, double max_sq_distance) const {
+  ClosestPoint best;
+  best.sq_distance = max_sq_distance;
+  if (nodes_.empty()) return best;
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& n = nodes_[stack[--top]];
+    if (spatial_detail::box_sq_distance(p, n.lo, n.hi) >= best.sq_distance) continue;
+    if (n.count > 0) {
+      for (int i = n.first; i < n.first + n.count; ++i) {
+        const int f = order_[i];
+        Eigen::Vector3d bary;
+        const Eigen::Vector3d q = closest_point_on_triangle(
+            p, V_.row(F_(f, 0)).transpose(), V_.row(F_(f, 1)).transpose(), V_.row(F_(f, 2)).transpose(), &bary);
+        const double d = (q - p).squaredNorm();
+        if (d < best.sq_distance || (d == best.sq_distance && best.face >= 0 && f < best.face)) {
+          best.sq_distance = d;
+          best.face = f;
+          best.point = q;
+          best.barycentric = bary;
+        }
+      }
+      continue;
+    }
+    // Visit the nearer child first (pushed last).
+    const double dl = spatial_detail::box_sq_distance(p, nodes_[n.left].lo, nodes_[n.left].hi);
+    const double dr = spatial_detail::box_sq_distance(p, nodes_[n.right].lo, nodes_[n.right].hi);
+    if (dl <= dr) {
+      stack[top++] = n.right;
+      stack[top++] = n.left;
+    } else {
+      stack[top++] = n.left;
+      stack[top++] = n.right;
+    }
+  }
+  return best;
+}
+
+int TriangleBvh::ray_winding(const Eigen::Vector3d& p, const Eigen::Vector3d& dir) const {
+  if (nodes_.empty()) return 0;
+  const Eigen::Vector3d inv = dir.cwiseInverse();
+  int winding = 0;
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& n = nodes_[stack[--top]];
+    if (!spatial_detail::ray_hits_box(p, inv, std::numeric_limits<double>::infinity(), n.lo, n.hi)) continue;
+    if (n.count > 0) {
+      for (int i = n.first; i < n.first + n.count; ++i) {
+        const int f = order_[i];
+        int sign = 0;
+        const double t = spatial_detail::ray_triangle(p, dir, V_.row(F_(f, 0)).transpose(),
+                                                      V_.row(F_(f, 1)).transpose(),
+                                                      V_.row(F_(f, 2)).transpose(), &sign);
+        if (t > 0) winding += sign;
+      }
+      continue;
+    }
+    stack[top++] = n.left;
+    stack[top++] = n.right;
+  }
+  return winding;
+}
+
+bool TriangleBvh::inside(const Eigen::Vector3d& p) const {
+  // Irrational-ish fixed directions so that rays rarely graze edges of axis-aligned models.
+  static const double dirs[7][3] = {{0.5366, 0.7071, 0.4603},  {-0.6247, 0.3312, -0.7071},
+                                    {0.1118, -0.8944, 0.4331}, {-0.7771, -0.2213, 0.5893},
+                                    {0.8163, -0.3397, -0.4671}, {-0.2041, 0.9613, -0.1848},
+                                    {0.3015, 0.0745, -0.9505}};
+  int votes = 0;
+  for (const auto& d : dirs)
+    if (std::abs(ray_winding(p, Eigen::Vector3d(d[0], d[1], d[2]))) >= 1) ++votes;
+  return votes >= 4;
+}
+
+bool TriangleBvh::segment_hits(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                               const std::function<bool(int)>& skip) const {
+  if (nodes_.empty()) return false;
+  const Eigen::Vector3d dir = b - a;
+  const double len = dir.norm();
+  if (!(len > 0)) return false;
+  const Eigen::Vector3d inv = dir.cwiseInverse();
+  const double eps = 1e-9;
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& n = nodes_[stack[--top]];
+    if (!spatial_detail::ray_hits_box(a, inv, 1.0, n.lo, n.hi)) continue;
+    if (n.count > 0) {
+      for (int i = n.first; i < n.first + n.count; ++i) {
+        const int f = order_[i];
+        if (skip && skip(f)) continue;
+        int sign = 0;
+        const double t = spatial_detail::ray_triangle(a, dir, V_.row(F_(f, 0)).transpose(),
+                                                      V_.row(F_(f, 1)).transpose(),
+                                                      V_.row(F_(f, 2)).transpose(), &sign);
+        if (t > eps && t < 1.0 - eps) return true;
+      }
+      continue;
+    }
+    stack[top++] = n.left;
+    stack[top++] = n.right;
+  }
+  return false;
+}
+
+void TriangleBvh::for_each_overlapping(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                       const std::function<void(int)>& visit) const {
+  if (nodes_.empty()) return;
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& n = nodes_[stack[--top]];
+    if ((n.lo.array() > hi.array()).any() || (n.hi.array() < lo.array()).any()) continue;
+    if (n.count > 0) {
+      for (int i = n.first; i < n.first + n.count; ++i) {
+        const int f = order_[i];
+        Eigen::Vector3d flo = V_.row(F_(f, 0)).transpose(), fhi = flo;
+        for (int k = 1; k < 3; ++k) {
+          flo = flo.cwiseMin(V_.row(F_(f, k)).transpose());
+          fhi = fhi.cwiseMax(V_.row(F_(f, k)).transpose());
+        }
+        if ((flo.array() > hi.array()).any() || (fhi.array() < lo.array()).any()) continue;
+        visit(f);
+      }
+      continue;
+    }
+    stack[top++] = n.right;
+    stack[top++] = n.left;
+  }
+}
+
+}  // namespace mm

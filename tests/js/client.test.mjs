@@ -1,0 +1,144 @@
+// The main-thread client (web/src/client.js) against the real worker runtime, ops and wasm
+// bindings, hosted in node worker threads (node_worker.mjs): request ids, progress,
+// transfer, both cancel strategies, restoring state into a replacement worker, and
+// respawning a worker that fails to start or traps.
+import assert from 'node:assert/strict';
+import { test } from 'node:test';
+import { Worker } from 'node:worker_threads';
+import { MeshMorphClient } from '../../web/src/client.js';
+import { dataBytes } from './wasm_module.mjs';
+
+const workerUrl = new URL('./node_worker.mjs', import.meta.url);
+
+// The browser Worker interface over a node worker thread.
+class NodeWorker {
+  constructor(workerData) {
+    this.thread = new Worker(workerUrl, { workerData });
+    this.thread.on('message', (data) => this.onmessage?.({ data }));
+    this.thread.on('error', (e) => this.onerror?.({ message: e.message, preventDefault() {} }));
+  }
+  postMessage(message, transfer) { this.thread.postMessage(message, transfer); }
+  terminate() { this.thread.terminate(); }
+}
+
+function makeClient(options = {}, workerData = {}) {
+  let started = 0;
+  const client = new MeshMorphClient({
+    createWorker: () => { started += 1; return new NodeWorker(workerData); },
+    cancelGraceMs: 3000,
+    ...options,
+  });
+  return { client, started: () => started };
+}
+
+async function loadArmadillo(client) {
+  const bytes = dataBytes('edit/armadillo.ply');
+  const { promise } = client.run('load', { name: 'armadillo.ply' }, { 'armadillo.ply': bytes }, { restoreKey: 'mesh:main' });
+  const result = await promise;
+  assert.equal(bytes.byteLength, 0, 'the file bytes were transferred, not copied');
+  return result;
+}
+
+// Runs eigs k=100 (seconds on the armadillo) and cancels it at its first progress message.
+async function cancelLongEigs(client) {
+  let cancelled = false;
+  const { id, promise } = client.run('eigs', { k: 100 }, {}, {
+    onProgress: () => {
+      if (!cancelled) { cancelled = true; client.cancel(id); }
+    },
+  });
+  const started = Date.now();
+  await assert.rejects(promise, (e) => e.code === 'Cancelled');
+  assert.ok(cancelled, 'progress was reported before the result');
+  return Date.now() - started;
+}
+
+test('load and eigs through the client: progress, results, transfer', async () => {
+  const { client } = makeClient();
+  try {
+    const ready = await client.ready;
+    assert.ok(ready.ops.includes('load') && ready.ops.includes('eigs'));
+    const { info, buffers } = await loadArmadillo(client);
+    assert.equal(info.weldedVertices, 14587);
+    assert.ok(buffers.positions instanceof Float32Array);
+    const stages = [];
+    const { promise } = client.run('eigs', { k: 8 }, {}, { onProgress: (stage, f) => stages.push([stage, f]) });
+    const eigs = await promise;
+    assert.equal(eigs.buffers.eigenvalues.length, 8);
+    assert.ok(stages.length > 0 && stages.every(([s, f]) => s === 'eigenbasis' && f >= 0 && f <= 1));
+    await assert.rejects(client.run('nonsense').promise, (e) => e.code === 'InvalidArgument' && /unknown op/.test(e.message));
+    await assert.rejects(client.run('load', { name: 'x.ply' }, { 'x.ply': new Uint8Array([1, 2, 3]) }).promise, (e) => e.code === 'ParseError');
+  } finally {
+    client.dropWorker();
+  }
+});
+
+test('cooperative cancel (SharedArrayBuffer flag): the worker and its mesh survive', async () => {
+  const { client, started } = makeClient({ cancelMode: 'cooperative' });
+  try {
+    assert.equal(client.cancelMode, 'cooperative');
+    await loadArmadillo(client);
+    const ms = await cancelLongEigs(client);
+    assert.ok(ms < 3000, `cancel took ${ms} ms`);
+    assert.equal(client.restarts, 0);
+    assert.equal(started(), 1);
+    const { buffers } = await client.run('eigs', { k: 4 }).promise;
+    assert.equal(buffers.eigenvalues.length, 4);
+  } finally {
+    client.dropWorker();
+  }
+});
+
+test('terminate cancel: a new worker replays the load; queued requests are aborted', async () => {
+  const { client, started } = makeClient({ cancelMode: 'terminate' });
+  try {
+    assert.equal(client.cancelMode, 'terminate');
+    await loadArmadillo(client);
+    const long = cancelLongEigs(client);
+    const queued = client.run('eigs', { k: 3 }).promise; // waits behind the long one
+    const [ms] = await Promise.all([long, assert.rejects(queued, (e) => e.code === 'Aborted')]);
+    assert.ok(ms < 3000, `cancel took ${ms} ms`);
+    assert.equal(client.restarts, 1);
+    assert.equal(started(), 2);
+    // No new load: the replacement worker got the armadillo from the restore list.
+    const { info } = await client.run('eigs', { k: 4 }).promise;
+    assert.equal(info.weldedVertices, 14587);
+  } finally {
+    client.dropWorker();
+  }
+});
+
+test('a worker that fails to start is replaced; after too many failures requests reject with InitFailed', async () => {
+  const failInits = new Int32Array(new SharedArrayBuffer(4));
+  Atomics.store(failInits, 0, 2);
+  const flaky = makeClient({ maxInitAttempts: 3 }, { failInits });
+  try {
+    await flaky.client.ready;
+    assert.equal(flaky.started(), 3, 'two failed starts, then a good one');
+    const { info } = await flaky.client.run('load', { name: 'hand.ply' }, { 'hand.ply': dataBytes('edit/hand_lowres.ply') }).promise;
+    assert.equal(info.weldedVertices, 810);
+  } finally {
+    flaky.client.dropWorker();
+  }
+
+  const broken = new Int32Array(new SharedArrayBuffer(4));
+  Atomics.store(broken, 0, 1000);
+  const dead = makeClient({ maxInitAttempts: 2 }, { failInits: broken });
+  await assert.rejects(dead.client.ready, (e) => e.code === 'InitFailed' && /simulated start failure/.test(e.message));
+  await assert.rejects(dead.client.run('eigs', { k: 3 }).promise, (e) => e.code === 'InitFailed');
+  dead.client.dropWorker();
+});
+
+test('a wasm trap replaces the worker and restores the mesh', async () => {
+  const { client, started } = makeClient();
+  try {
+    await client.run('load', { name: 'hand.ply' }, { 'hand.ply': dataBytes('edit/hand_lowres.ply') }, { restoreKey: 'mesh:main' }).promise;
+    await assert.rejects(client.run('crash').promise, (e) => e.code === 'Crashed' && /unreachable/.test(e.message));
+    const { info } = await client.run('eigs', { k: 3 }).promise;
+    assert.equal(info.weldedVertices, 810);
+    assert.equal(started(), 2);
+    assert.equal(client.restarts, 1);
+  } finally {
+    client.dropWorker();
+  }
+});

@@ -1,0 +1,164 @@
+// Tests of core/spatial: BVH closest point / rays / inside test against brute force, and
+// farthest-point sampling invariants.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "spatial/farthest_point_sampling.h"
+#include "spatial/triangle_bvh.h"
+
+namespace {
+
+// Unit cube [0,1]^3, 12 outward-facing triangles.
+void unit_cube(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  V->resize(8, 3);
+  *V << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1;
+  F->resize(12, 3);
+  *F << 0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4, 2, 3, 7, 2, 7, 6, 1, 2, 6, 1, 6, 5, 0, 4, 7, 0, 7, 3;
+}
+
+// A deterministic pseudo-random sequence (LCG) for test points.
+struct Lcg {
+  uint64_t s = 12345;
+  double next() {
+    s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+    return double(s >> 11) / double(1ULL << 53);
+  }
+};
+
+// A sphere-ish icosphere-free soup: UV sphere with n×n cells.
+void uv_sphere(int n, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  const int rings = n, segs = 2 * n;
+  V->resize((rings - 1) * segs + 2, 3);
+  int k = 0;
+  V->row(k++) << 0, 0, 1;
+  for (int r = 1; r < rings; ++r)
+    for (int s = 0; s < segs; ++s) {
+      const double th = M_PI * r / rings, ph = 2 * M_PI * s / segs;
+      V->row(k++) << std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th);
+    }
+  V->row(k++) << 0, 0, -1;
+  std::vector<Eigen::Vector3i> f;
+  for (int s = 0; s < segs; ++s) f.push_back({0, 1 + s, 1 + (s + 1) % segs});
+  for (int r = 0; r < rings - 2; ++r)
+    for (int s = 0; s < segs; ++s) {
+      const int a = 1 + r * segs + s, b = 1 + r * segs + (s + 1) % segs;
+      const int c = a + segs, d = b + segs;
+      f.push_back({a, c, d});
+      f.push_back({a, d, b});
+    }
+  const int south = k - 1, last = 1 + (rings - 2) * segs;
+  for (int s = 0; s < segs; ++s) f.push_back({south, last + (s + 1) % segs, last + s});
+  F->resize(f.size(), 3);
+  for (size_t i = 0; i < f.size(); ++i) F->row(i) = f[i].transpose();
+}
+
+}  // namespace
+
+TEST(SpatialBvh, ClosestPointMatchesBruteForce) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  uv_sphere(12, &V, &F);
+  mm::TriangleBvh bvh(V, F);
+  Lcg rng;
+  for (int q = 0; q < 200; ++q) {
+    const Eigen::Vector3d p(3 * rng.next() - 1.5, 3 * rng.next() - 1.5, 3 * rng.next() - 1.5);
+    double best = 1e300;
+    for (int f = 0; f < F.rows(); ++f) {
+      Eigen::Vector3d b;
+      const Eigen::Vector3d c = mm::closest_point_on_triangle(p, V.row(F(f, 0)), V.row(F(f, 1)), V.row(F(f, 2)), &b);
+      best = std::min(best, (c - p).squaredNorm());
+    }
+    const mm::ClosestPoint cp = bvh.closest_point(p);
+    ASSERT_GE(cp.face, 0);
+    EXPECT_NEAR(cp.sq_distance, best, 1e-12);
+    // The barycentric weights reproduce the point.
+    const Eigen::Vector3d r = cp.barycentric[0] * V.row(F(cp.face, 0)).transpose() +
+                              cp.barycentric[1] * V.row(F(cp.face, 1)).transpose() +
+                              cp.barycentric[2] * V.row(F(cp.face, 2)).transpose();
+    EXPECT_LT((r - cp.point).norm(), 1e-12);
+  }
+}
+
+TEST(SpatialBvh, InsideAndWinding) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  unit_cube(&V, &F);
+  mm::TriangleBvh bvh(V, F);
+  EXPECT_TRUE(bvh.inside({0.5, 0.5, 0.5}));
+  EXPECT_TRUE(bvh.inside({0.1, 0.9, 0.2}));
+  EXPECT_FALSE(bvh.inside({1.5, 0.5, 0.5}));
+  EXPECT_FALSE(bvh.inside({-0.1, -0.1, 2}));
+  EXPECT_EQ(bvh.ray_winding({0.5, 0.5, 0.5}, {0.3, 0.2, 1}), 1);
+  // Inverted orientation: |winding| still says inside.
+  Eigen::MatrixXi Fi = F;
+  Fi.col(1).swap(Fi.col(2));
+  mm::TriangleBvh inv(V, Fi);
+  EXPECT_EQ(inv.ray_winding({0.5, 0.5, 0.5}, {0.3, 0.2, 1}), -1);
+  EXPECT_TRUE(inv.inside({0.5, 0.5, 0.5}));
+  // Two overlapping cubes (a multi-part character): the overlap is inside.
+  Eigen::MatrixXd V2(16, 3);
+  V2 << V, (V.array() + 0.5).matrix();
+  Eigen::MatrixXi F2(24, 3);
+  F2 << F, (F.array() + 8).matrix();
+  mm::TriangleBvh two(V2, F2);
+  EXPECT_TRUE(two.inside({0.75, 0.75, 0.75}));
+  EXPECT_TRUE(two.inside({1.25, 1.25, 1.25}));
+  EXPECT_FALSE(two.inside({1.25, 0.25, 0.25}));
+}
+
+TEST(SpatialBvh, SegmentHits) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  unit_cube(&V, &F);
+  mm::TriangleBvh bvh(V, F);
+  EXPECT_TRUE(bvh.segment_hits({0.5, 0.5, 0.5}, {0.5, 0.5, 2}));
+  EXPECT_FALSE(bvh.segment_hits({0.2, 0.5, 0.5}, {0.8, 0.5, 0.5}));
+  EXPECT_FALSE(bvh.segment_hits({2, 2, 2}, {3, 3, 3}));
+  int n = 0;
+  bvh.for_each_overlapping({0.9, 0.9, 0.9}, {1.1, 1.1, 1.1}, [&](int) { ++n; });
+  EXPECT_GT(n, 0);
+}
+
+TEST(SpatialSampling, FarthestPointSamplingSpreadsAndIsDeterministic) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  uv_sphere(16, &V, &F);
+  double r1 = 0;
+  const std::vector<int> a = mm::farthest_point_sampling(V, 40, 0, &r1);
+  const std::vector<int> b = mm::farthest_point_sampling(V, 40, 0);
+  EXPECT_EQ(a, b);
+  ASSERT_EQ(a.size(), 40u);
+  std::vector<int> sorted = a;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_EQ(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  // Every vertex is within the sampling radius of a chosen point (covering property), and the
+  // chosen points are at least that far apart (packing property).
+  for (int i = 0; i < V.rows(); ++i) {
+    double d = 1e300;
+    for (int s : a) d = std::min(d, (V.row(i) - V.row(s)).norm());
+    EXPECT_LE(d, r1 + 1e-12);
+  }
+  for (size_t i = 0; i < a.size(); ++i)
+    for (size_t j = i + 1; j < a.size(); ++j) EXPECT_GE((V.row(a[i]) - V.row(a[j])).norm(), r1 - 1e-12);
+  // On a unit sphere, 40 well-spread points are ~0.5 apart (area 4π / 40 per point).
+  EXPECT_GT(r1, 0.3);
+  EXPECT_EQ(mm::farthest_point_sampling(V, 1000, 0).size(), size_t(V.rows()));
+}
+
+TEST(SpatialSampling, SurfaceSamplesCoverFacesUniformly) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  unit_cube(&V, &F);
+  const mm::SurfaceSamples S = mm::surface_samples(V, F, 1000);
+  // 8 corners + 12 faces × 4^L centroids with area 0.5/4^L ≤ 6/1000 → L = 3 (64 each).
+  EXPECT_EQ(S.size(), 8 + 12 * 64);
+  for (int s = 0; s < S.size(); ++s) {
+    EXPECT_NEAR(S.barycentric.row(s).sum(), 1.0, 1e-12);
+    EXPECT_GE(S.barycentric.row(s).minCoeff(), 0.0);
+    EXPECT_NEAR(S.N.row(s).norm(), 1.0, 1e-12);
+  }
+  // Deformed copy: positions follow the vertices.
+  const Eigen::MatrixXd V2 = 2 * V;
+  EXPECT_LT((S.positions(V2, F) - 2 * S.P).norm(), 1e-12);
+}

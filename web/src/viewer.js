@@ -1,0 +1,126 @@
+// The three.js view: renderer, camera with orbit controls, lights, one mesh whose
+// BufferGeometry is swapped by arrays.js. Renders on demand (controls change, geometry
+// change, resize) instead of every frame, so an idle page costs nothing and headless tests
+// on a software GPU stay fast.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { applyArrays } from './arrays.js';
+
+export const backgroundColor = 0x1d2230;
+const surfaceColor = 0xc9cfd8;
+
+export class Viewer {
+  constructor(canvas) {
+    // preserveDrawingBuffer keeps the last frame readable (screenshots, e2e pixel checks,
+    // drawImage) at a small cost that does not matter for a single mesh.
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+    this.renderer.setClearColor(backgroundColor);
+    this.scene = new THREE.Scene();
+    this.camera = new THREE.PerspectiveCamera(40, 1, 0.01, 100);
+
+    // Hemisphere light for a soft ambient term, a key light that follows the camera (the
+    // side the user looks at is always lit) and a rim light from behind for silhouettes.
+    this.scene.add(new THREE.HemisphereLight(0xf2f4ff, 0x3a3530, 1.0));
+    const key = new THREE.DirectionalLight(0xffffff, 1.6);
+    key.position.set(0.6, 0.8, 1);
+    this.camera.add(key);
+    const rim = new THREE.DirectionalLight(0xbfd4ff, 0.7);
+    rim.position.set(-0.5, 0.3, -1);
+    this.camera.add(rim);
+    this.scene.add(this.camera);
+
+    this.material = new THREE.MeshStandardMaterial({
+      color: surfaceColor, roughness: 0.62, metalness: 0.0, side: THREE.DoubleSide,
+      polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1,
+    });
+    this.wireMaterial = new THREE.MeshBasicMaterial({ color: 0x10131a, wireframe: true, transparent: true, opacity: 0.35 });
+    this.geometry = new THREE.BufferGeometry();
+    this.mesh = new THREE.Mesh(this.geometry, this.material);
+    this.wire = new THREE.Mesh(this.geometry, this.wireMaterial);
+    this.wire.visible = false;
+    this.scene.add(this.mesh, this.wire);
+
+    this.controls = new OrbitControls(this.camera, canvas);
+    this.controls.enableDamping = false;
+    this.controls.addEventListener('change', () => this.requestRender());
+
+    this.frames = 0;  // rendered frames (tests wait for this to advance)
+    this.pendingFrame = false;
+    new ResizeObserver(() => this.resize()).observe(canvas);
+    this.resize();
+  }
+
+  resize() {
+    const canvas = this.renderer.domElement;
+    const width = canvas.clientWidth || 1;
+    const height = canvas.clientHeight || 1;
+    this.renderer.setSize(width, height, false);
+    this.camera.aspect = width / height;
+    this.camera.updateProjectionMatrix();
+    this.requestRender();
+  }
+
+  requestRender() {
+    if (this.pendingFrame) return;
+    this.pendingFrame = true;
+    requestAnimationFrame(() => {
+      this.pendingFrame = false;
+      this.renderer.render(this.scene, this.camera);
+      this.frames += 1;
+    });
+  }
+
+  // A new mesh: positions/normals/indices from the worker's load result. Replaces the
+  // geometry (sizes differ) and frames the camera on it.
+  // `open`: the surface has boundaries, so its inside can be seen and back faces are drawn
+  // (on closed meshes they only add dark speckles along silhouettes).
+  setMesh({ positions, normals, indices }, { open = true } = {}) {
+    this.material.side = open ? THREE.DoubleSide : THREE.FrontSide;
+    this.material.needsUpdate = true;
+    const geometry = new THREE.BufferGeometry();
+    applyArrays(geometry, { positions, normals, indices });
+    if (!normals) geometry.computeVertexNormals();
+    this.mesh.geometry = geometry;
+    this.wire.geometry = geometry;
+    this.geometry.dispose();
+    this.geometry = geometry;
+    this.setColors(null);
+    this.frame();
+  }
+
+  // Per-vertex colours (#R·3 in 0..1, raw layout) or null for the plain surface.
+  setColors(colors) {
+    applyArrays(this.geometry, { colors });
+    const useColors = Boolean(colors);
+    if (this.material.vertexColors !== useColors) {
+      this.material.vertexColors = useColors;
+      this.material.color.set(useColors ? 0xffffff : surfaceColor);
+      this.material.needsUpdate = true;
+    }
+    this.requestRender();
+  }
+
+  setWireframe(on) {
+    this.wire.visible = on;
+    this.requestRender();
+  }
+
+  // Looks at the bounding sphere from the front, slightly above, so that the whole mesh fits
+  // the narrower side of the view.
+  frame() {
+    const sphere = this.geometry.boundingSphere;
+    if (!sphere || !(sphere.radius > 0)) return;
+    const vFov = THREE.MathUtils.degToRad(this.camera.fov);
+    const hFov = 2 * Math.atan(Math.tan(vFov / 2) * this.camera.aspect);
+    const distance = (sphere.radius / Math.sin(Math.min(vFov, hFov) / 2)) * 1.08;
+    const direction = new THREE.Vector3(0.35, 0.25, 1).normalize();
+    this.camera.near = distance / 100;
+    this.camera.far = distance * 10;
+    this.camera.position.copy(sphere.center).addScaledVector(direction, distance);
+    this.camera.updateProjectionMatrix();
+    this.controls.target.copy(sphere.center);
+    this.controls.update();
+    this.requestRender();
+  }
+}
