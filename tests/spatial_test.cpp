@@ -151,8 +151,8 @@ TEST(SpatialSampling, SurfaceSamplesCoverFacesUniformly) {
   Eigen::MatrixXi F;
   unit_cube(&V, &F);
   const mm::SurfaceSamples S = mm::surface_samples(V, F, 1000);
-  // 8 corners + 12 faces × 4^L centroids with area 0.5/4^L ≤ 6/1000 → L = 3 (64 each).
-  EXPECT_EQ(S.size(), 8 + 12 * 64);
+  // 8 corners + 12 faces × 4^L centroids with area 0.5/4^L ≤ 6/1000 → L = 4 (256 each).
+  EXPECT_EQ(S.size(), 8 + 12 * 256);
   for (int s = 0; s < S.size(); ++s) {
     EXPECT_NEAR(S.barycentric.row(s).sum(), 1.0, 1e-12);
     EXPECT_GE(S.barycentric.row(s).minCoeff(), 0.0);

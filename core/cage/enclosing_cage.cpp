@@ -93,7 +93,8 @@ EnclosingCage enclosing_cage(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   ho.target_vertices = opt.target_vertices;
   ho.max_normal_turn_deg = opt.max_normal_turn_deg;
   ho.length_weight = opt.length_weight;
-  HullDecimation dec = hull_decimation(offset.V, offset.F, ho, progress.sub(0.35, 0.9));
+  const double clearance = opt.min_clearance * diag;
+  HullDecimation dec = hull_decimation(offset.V, offset.F, V, clearance, ho, progress.sub(0.35, 0.9));
   if (!dec.status.ok()) {
     out.status = dec.status;
     return out;
@@ -102,7 +103,6 @@ EnclosingCage enclosing_cage(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   out.V = std::move(dec.V);
   out.F = std::move(dec.F);
 
-  const double clearance = opt.min_clearance * diag;
   CageContainment cc = cage_containment(V, out.V, out.F, 10 * clearance);
   std::vector<int> bad = enclosing_detail::cage_failures(cc, clearance);
   for (int round = 0; round < opt.repair_rounds && !bad.empty(); ++round) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <iterator>
 #include <queue>
 #include <vector>
@@ -12,11 +13,19 @@
 namespace mm {
 
 namespace hull_detail {
+#ifdef MM_HULL_DEBUG
+int g_dbg[10];
+#define DBG(i) (++g_dbg[i])
+#else
+#define DBG(i) ((void)0)
+#endif
 
 using cage_detail::Vec3;
 using cage_detail::cross;
 using cage_detail::dot;
 using cage_detail::norm;
+
+constexpr double kPi = 3.14159265358979323846;
 
 // Area-weighted plane quadric: Q(p) = Σ area·(n·p − d)², stored as the symmetric 4x4.
 struct Quadric {
@@ -42,7 +51,7 @@ struct Quadric {
     const double c00 = a11 * a22 - a12 * a12, c01 = a02 * a12 - a01 * a22, c02 = a01 * a12 - a02 * a11;
     const double det = a00 * c00 + a01 * c01 + a02 * c02;
     const double tr = (a00 + a11 + a22) / 3;
-    if (!(std::abs(det) > 1e-6 * tr * tr * tr) || !(tr > 0)) return false;
+    if (!(tr > 0) || !(std::abs(det) > 1e-6 * tr * tr * tr)) return false;
     const double c11 = a00 * a22 - a02 * a02, c12 = a01 * a02 - a00 * a12, c22 = a00 * a11 - a01 * a01;
     const double inv = 1.0 / det;
     *p = Vec3(-(c00 * b0 + c01 * b1 + c02 * b2) * inv, -(c01 * b0 + c11 * b1 + c12 * b2) * inv,
@@ -63,16 +72,89 @@ struct HeapEntry {
   }
 };
 
-struct Candidate {
-  bool ok = false;
-  Vec3 p;
-  double cost = 0;
+struct Candidates {
+  int n = 0;
+  Vec3 p[4];
+  double cost[4];
+};
+
+// Signed solid angle of triangle (a, b, c) seen from x (Van Oosterom & Strackee 1983);
+// positive when x is on the inner side of a counter-clockwise (outward) triangle.
+double hull_solid_angle(const Vec3& x, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 A = a - x, B = b - x, C = c - x;
+  const double la = norm(A), lb = norm(B), lc = norm(C);
+  const double det = dot(A, cross(B, C));
+  const double den = la * lb * lc + dot(A, B) * lc + dot(A, C) * lb + dot(B, C) * la;
+  return 2.0 * std::atan2(det, den);
+}
+
+// Points in a uniform grid (CSR layout) for box queries.
+class PointGrid {
+ public:
+  PointGrid(const Eigen::MatrixXd& P) : P_(P) {
+    const int n = static_cast<int>(P.rows());
+    if (n == 0) return;
+    Vec3 lo(P(0, 0), P(0, 1), P(0, 2)), hi = lo;
+    for (int i = 0; i < n; ++i) {
+      lo = Vec3(std::min(lo.x, P(i, 0)), std::min(lo.y, P(i, 1)), std::min(lo.z, P(i, 2)));
+      hi = Vec3(std::max(hi.x, P(i, 0)), std::max(hi.y, P(i, 1)), std::max(hi.z, P(i, 2)));
+    }
+    lo_ = lo;
+    const double longest = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, 1e-300});
+    cell_ = longest / 48.0;
+    for (int k = 0; k < 3; ++k) dims_[k] = static_cast<int>(std::floor((hi[k] - lo[k]) / cell_)) + 1;
+    std::vector<int> cell_of(n);
+    start_.assign(static_cast<size_t>(dims_[0]) * dims_[1] * dims_[2] + 1, 0);
+    for (int i = 0; i < n; ++i) {
+      cell_of[i] = cell_index(coord(P(i, 0), 0), coord(P(i, 1), 1), coord(P(i, 2), 2));
+      ++start_[cell_of[i] + 1];
+    }
+    for (size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
+    ids_.resize(n);
+    std::vector<int> fill(start_.begin(), start_.end() - 1);
+    for (int i = 0; i < n; ++i) ids_[fill[cell_of[i]]++] = i;
+  }
+
+  // Calls fn(i, point) for every point in the box [lo, hi].
+  template <class Fn>
+  bool for_each_in_box(const Vec3& lo, const Vec3& hi, Fn fn) const {
+    if (ids_.empty()) return true;
+    int r0[3], r1[3];
+    for (int k = 0; k < 3; ++k) {
+      r0[k] = coord(lo[k], k);
+      r1[k] = coord(hi[k], k);
+    }
+    for (int z = r0[2]; z <= r1[2]; ++z)
+      for (int y = r0[1]; y <= r1[1]; ++y)
+        for (int x = r0[0]; x <= r1[0]; ++x) {
+          const int c = cell_index(x, y, z);
+          for (int s = start_[c]; s < start_[c + 1]; ++s) {
+            const int i = ids_[s];
+            const Vec3 p(P_(i, 0), P_(i, 1), P_(i, 2));
+            if (p.x < lo.x || p.y < lo.y || p.z < lo.z || p.x > hi.x || p.y > hi.y || p.z > hi.z) continue;
+            if (!fn(p)) return false;
+          }
+        }
+    return true;
+  }
+
+ private:
+  int coord(double v, int k) const {
+    return std::clamp(static_cast<int>(std::floor((v - lo_[k]) / cell_)), 0, dims_[k] - 1);
+  }
+  int cell_index(int x, int y, int z) const { return x + dims_[0] * (y + dims_[1] * z); }
+  const Eigen::MatrixXd& P_;
+  Vec3 lo_;
+  double cell_ = 1;
+  int dims_[3] = {1, 1, 1};
+  std::vector<int> start_, ids_;
 };
 
 class Decimator {
  public:
-  Decimator(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const HullDecimationOptions& opt)
-      : opt_(opt) {
+  Decimator(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Eigen::MatrixXd& P, double clearance,
+            const HullDecimationOptions& opt)
+      : opt_(opt), points_(P), clearance_(clearance) {
     const int n = static_cast<int>(V.rows());
     pos_.resize(n);
     for (int i = 0; i < n; ++i) pos_[i] = Vec3(V(i, 0), V(i, 1), V(i, 2));
@@ -100,9 +182,8 @@ class Decimator {
     for (int i = 0; i < n; ++i) alive_vertices_ += vert_alive_[i];
     alive_faces_ = static_cast<int>(F.rows());
     stamp_.assign(F.rows(), 0);
+    cos_turn_ = std::cos(opt_.max_normal_turn_deg * kPi / 180.0);
   }
-
-  int alive_vertices() const { return alive_vertices_; }
 
   Status run(const Progress& progress, int* collapses) {
     rebuild_grid();
@@ -117,16 +198,16 @@ class Decimator {
       const HeapEntry e = heap_.top();
       heap_.pop();
       if (!vert_alive_[e.a] || !vert_alive_[e.b] || version_[e.a] != e.va || version_[e.b] != e.vb) continue;
-      const Candidate c = candidate(e.a, e.b);
-      if (!c.ok) continue;
-      if (c.cost > e.cost + 1e-12 * std::abs(e.cost) + 1e-300) {
-        heap_.push({c.cost, e.a, e.b, e.va, e.vb});  // neighbourhood changed since: re-queue
+      const Candidates c = candidates(e.a, e.b);
+      if (c.n == 0) continue;
+      if (c.cost[0] > e.cost + 1e-12 * std::abs(e.cost) + 1e-300) {
+        heap_.push({c.cost[0], e.a, e.b, e.va, e.vb});  // neighbourhood changed since: re-queue
         continue;
       }
-      if (!collapse(e.a, e.b, c.p)) continue;
+      if (!collapse(e.a, e.b, c)) continue;
       ++done;
       if (alive_faces_ * 2 < grid_faces_) rebuild_grid();
-      if (done % 512 == 0) {
+      if (done % 256 == 0) {
         const double f = double(start - alive_vertices_) / std::max(1, start - opt_.target_vertices);
         if (!progress.update("cage: simplify", f)) return cancelled_status("cage: simplify");
       }
@@ -188,77 +269,49 @@ class Decimator {
     return s;
   }
 
-  Candidate candidate(int a, int b) {
-    Candidate best;
-    const std::vector<int> s = star(a, b);
+  // Up to four positions for the merged vertex (quadric minimiser, midpoint, endpoints),
+  // sorted by cost = quadric error / area (mean squared distance to the offset surface's
+  // planes) + length_weight · |ab|².
+  Candidates candidates(int a, int b) const {
+    Candidates out;
     Quadric q = quadric_[a];
     q.add(quadric_[b]);
-    struct Plane { Vec3 n; double d; };
-    std::vector<Plane> planes;
-    planes.reserve(s.size());
-    Vec3 m;
-    for (int f : s) {
-      const Vec3 A = face_area_vector(f);
-      const double l = norm(A);
-      m = m + A;
-      if (l > 0) planes.push_back({(1.0 / l) * A, dot((1.0 / l) * A, pos_[faces_[f][0]])});
-    }
-    m = cage_detail::normalized(m);
-    const Vec3 pa = pos_[a], pb = pos_[b];
+    const Vec3 pa = pos_[a], pb = pos_[b], mid = 0.5 * (pa + pb);
     const double len2 = dot(pb - pa, pb - pa);
-    const double scale = std::sqrt(len2);
-    Vec3 cands[4];
+    const double len = std::sqrt(len2);
+    Vec3 cand[4];
     int nc = 0;
     Vec3 opt_p;
-    if (q.minimiser(&opt_p) && norm(opt_p - 0.5 * (pa + pb)) < 2 * scale) cands[nc++] = opt_p;
-    cands[nc++] = 0.5 * (pa + pb);
-    cands[nc++] = pa;
-    cands[nc++] = pb;
+    if (q.minimiser(&opt_p) && norm(opt_p - mid) < len) cand[nc++] = opt_p;
+    cand[nc++] = mid;
+    cand[nc++] = pa;
+    cand[nc++] = pb;
     const double norm_area = q.area > 0 ? q.area : 1.0;
     for (int i = 0; i < nc; ++i) {
-      Vec3 c = cands[i];
-      // Progressive hull: push along the mean normal until c is outside every plane.
-      double t = 0;
-      bool feasible = true;
-      for (const Plane& pl : planes) {
-        const double sdist = dot(pl.n, c) - pl.d;
-        if (sdist >= 0) continue;
-        const double nm = dot(pl.n, m);
-        if (nm <= 1e-3) {
-          feasible = false;
-          break;
-        }
-        t = std::max(t, -sdist / nm);
-      }
-      if (!feasible) continue;
-      if (t > 0) c = c + (t * (1 + 1e-9) + 1e-12 * scale) * m;
-      for (const Plane& pl : planes)
-        if (dot(pl.n, c) - pl.d < -1e-12 * scale) {
-          feasible = false;
-          break;
-        }
-      if (!feasible) continue;
-      const double cost = std::max(0.0, q.eval(c)) / norm_area + opt_.length_weight * len2;
-      if (!best.ok || cost < best.cost) {
-        best.ok = true;
-        best.p = c;
-        best.cost = cost;
-      }
+      out.p[i] = cand[i];
+      out.cost[i] = std::max(0.0, q.eval(cand[i])) / norm_area + opt_.length_weight * len2;
     }
-    return best;
+    out.n = nc;
+    // Insertion sort, stable (deterministic order for equal costs).
+    for (int i = 1; i < nc; ++i)
+      for (int j = i; j > 0 && out.cost[j] < out.cost[j - 1]; --j) {
+        std::swap(out.cost[j], out.cost[j - 1]);
+        std::swap(out.p[j], out.p[j - 1]);
+      }
+    return out;
   }
 
   void push(int a, int b) {
-    const Candidate c = candidate(a, b);
-    if (c.ok) heap_.push({c.cost, a, b, version_[a], version_[b]});
+    const Candidates c = candidates(a, b);
+    if (c.n > 0) heap_.push({c.cost[0], a, b, version_[a], version_[b]});
   }
 
-  bool collapse(int a, int b, const Vec3& p) {
+  bool collapse(int a, int b, const Candidates& cands) {
     // Link condition: the common neighbours of a and b are exactly the two opposite vertices.
     std::vector<int> edge_faces;
     for (int f : faces_of(a))
       if (has_vertex(faces_[f], b)) edge_faces.push_back(f);
-    if (edge_faces.size() != 2) return false;
+    if (edge_faces.size() != 2) { DBG(0); return false; }
     int opposite[2];
     for (int k = 0; k < 2; ++k) {
       const auto& t = faces_[edge_faces[k]];
@@ -268,43 +321,70 @@ class Decimator {
     const std::vector<int> na = neighbours(a), nb = neighbours(b);
     std::vector<int> common;
     std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
-    if (common.size() != 2) return false;
-    if (static_cast<int>(na.size() + nb.size()) - 4 < 3) return false;
+    if (common.size() != 2) { DBG(1); return false; }
+    if (static_cast<int>(na.size() + nb.size()) - 4 < 3) { DBG(2); return false; }
     for (int k = 0; k < 2; ++k)
-      if (neighbours(opposite[k]).size() <= 3) return false;
+      if (neighbours(opposite[k]).size() <= 3) { DBG(3); return false; }
 
-    // Surviving faces: new geometry must not flip, degenerate or hit unrelated faces.
     const std::vector<int> s = star(a, b);
-    const double cos_turn = std::cos(opt_.max_normal_turn_deg * 3.14159265358979323846 / 180.0);
-    std::vector<std::array<Vec3, 3>> moved;
+    for (int k = 0; k < cands.n; ++k)
+      if (valid_position(a, b, s, cands.p[k])) {
+        apply(a, b, edge_faces, cands.p[k]);
+        return true;
+      }
+    return false;
+  }
+
+  // Geometry tests of moving a and b to p: no flipped or degenerate face, no self-intersection,
+  // no point leaving the surface or coming closer than the clearance.
+  bool valid_position(int a, int b, const std::vector<int>& s, const Vec3& p) {
+    std::vector<std::array<Vec3, 3>> moved, old;
     std::vector<std::array<int, 3>> moved_ids;
+    Vec3 lo = p, hi = p;
     for (int f : s) {
       const auto& t = faces_[f];
+      const std::array<Vec3, 3> O = {pos_[t[0]], pos_[t[1]], pos_[t[2]]};
+      old.push_back(O);
+      for (const Vec3& v : O) {
+        lo = Vec3(std::min(lo.x, v.x), std::min(lo.y, v.y), std::min(lo.z, v.z));
+        hi = Vec3(std::max(hi.x, v.x), std::max(hi.y, v.y), std::max(hi.z, v.z));
+      }
       if (has_vertex(t, a) && has_vertex(t, b)) continue;
-      std::array<Vec3, 3> P;
+      std::array<Vec3, 3> P = O;
       std::array<int, 3> ids = t;
-      for (int c = 0; c < 3; ++c) {
+      for (int c = 0; c < 3; ++c)
         if (t[c] == a || t[c] == b) {
           P[c] = p;
           ids[c] = a;
-        } else {
-          P[c] = pos_[t[c]];
         }
-      }
-      const Vec3 old_n = face_area_vector(f);
+      const Vec3 old_n = cage_detail::area_vector(O[0], O[1], O[2]);
       const Vec3 new_n = cage_detail::area_vector(P[0], P[1], P[2]);
-      const double lo = norm(old_n), ln = norm(new_n);
-      if (!(ln > 1e-12 * (lo + 1e-300)) || !(ln > 0)) return false;
-      if (lo > 0 && dot(old_n, new_n) < cos_turn * lo * ln) return false;
+      const double lo_n = norm(old_n), ln = norm(new_n);
+      if (!(ln > 1e-12 * lo_n) || !(ln > 0)) { DBG(4); return false; }
+      if (lo_n > 0 && dot(old_n, new_n) < cos_turn_ * lo_n * ln) { DBG(5); return false; }
       moved.push_back(P);
       moved_ids.push_back(ids);
     }
-    if (opt_.check_self_intersections) {
+    if (opt_.check_self_intersections)
       for (size_t k = 0; k < moved.size(); ++k)
-        if (hits_other_face(moved[k], moved_ids[k], a, b)) return false;
-    }
+        if (hits_other_face(moved[k], moved_ids[k], a, b)) { DBG(6); return false; }
+    // Points: the winding number changes only inside the region swept between the old and the
+    // new star, which lies in the bounding box of their vertices.
+    const Vec3 pad(clearance_, clearance_, clearance_);
+    const double c2 = clearance_ * clearance_;
+    return points_.for_each_in_box(lo - pad, hi + pad, [&](const Vec3& x) {
+      double delta = 0;
+      for (const auto& P : moved) {
+        if (clearance_ > 0 && cage_detail::point_triangle_distance2(x, P[0], P[1], P[2]) < c2) { DBG(7); return false; }
+        delta += hull_solid_angle(x, P[0], P[1], P[2]);
+      }
+      for (const auto& O : old) delta -= hull_solid_angle(x, O[0], O[1], O[2]);
+      if (std::abs(delta) >= 2 * kPi) DBG(8);
+      return std::abs(delta) < 2 * kPi;
+    });
+  }
 
-    // Apply.
+  void apply(int a, int b, const std::vector<int>& edge_faces, const Vec3& p) {
     for (int f : edge_faces) face_alive_[f] = 0;
     alive_faces_ -= 2;
     pos_[a] = p;
@@ -324,7 +404,6 @@ class Decimator {
     list.erase(std::unique(list.begin(), list.end()), list.end());
     for (int f : faces_of(a)) grid_insert(f);
     for (int x : neighbours(a)) push(std::min(a, x), std::max(a, x));
-    return true;
   }
 
   // --- uniform grid over face bounding boxes, rebuilt as faces grow ---
@@ -380,8 +459,13 @@ class Decimator {
     cell_range(lo, hi, r0, r1);
     for (int z = r0[2]; z <= r1[2]; ++z)
       for (int y = r0[1]; y <= r1[1]; ++y)
-        for (int x = r0[0]; x <= r1[0]; ++x)
-          cells_[x + static_cast<size_t>(dims_[0]) * (y + static_cast<size_t>(dims_[1]) * z)].push_back(f);
+        for (int x = r0[0]; x <= r1[0]; ++x) {
+          auto& cell = cells_[x + static_cast<size_t>(dims_[0]) * (y + static_cast<size_t>(dims_[1]) * z)];
+          // Drop stale entries now and then so cells do not grow without bound.
+          if (cell.size() >= 32 && (cell.size() & (cell.size() - 1)) == 0)
+            cell.erase(std::remove_if(cell.begin(), cell.end(), [&](int g) { return !face_alive_[g]; }), cell.end());
+          cell.push_back(f);
+        }
   }
 
   bool hits_other_face(const std::array<Vec3, 3>& P, const std::array<int, 3>& ids, int a, int b) {
@@ -393,7 +477,7 @@ class Decimator {
     for (int z = r0[2]; z <= r1[2]; ++z)
       for (int y = r0[1]; y <= r1[1]; ++y)
         for (int x = r0[0]; x <= r1[0]; ++x) {
-          auto& cell = cells_[x + static_cast<size_t>(dims_[0]) * (y + static_cast<size_t>(dims_[1]) * z)];
+          const auto& cell = cells_[x + static_cast<size_t>(dims_[0]) * (y + static_cast<size_t>(dims_[1]) * z)];
           for (int g : cell) {
             if (stamp_[g] == query_ || !face_alive_[g]) continue;
             stamp_[g] = query_;
@@ -408,14 +492,14 @@ class Decimator {
               continue;
             if (cage_detail::triangles_intersect(P[0], P[1], P[2], Q[0], Q[1], Q[2])) return true;
           }
-          // Drop stale entries lazily so cells do not grow without bound.
-          if (cell.size() > 64)
-            cell.erase(std::remove_if(cell.begin(), cell.end(), [&](int g) { return !face_alive_[g]; }), cell.end());
         }
     return false;
   }
 
   HullDecimationOptions opt_;
+  PointGrid points_;
+  double clearance_ = 0;
+  double cos_turn_ = 0;
   std::vector<Vec3> pos_;
   std::vector<std::array<int, 3>> faces_;
   std::vector<uint8_t> face_alive_;
@@ -425,7 +509,7 @@ class Decimator {
   std::vector<unsigned> version_;
   std::priority_queue<HeapEntry> heap_;
   int alive_vertices_ = 0, alive_faces_ = 0, grid_faces_ = 0;
-  // grid
+  // grid over faces
   Vec3 grid_lo_;
   double cell_ = 1;
   int dims_[3] = {1, 1, 1};
@@ -436,14 +520,14 @@ class Decimator {
 
 }  // namespace hull_detail
 
-HullDecimation hull_decimation(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
-                               const HullDecimationOptions& opt, const Progress& progress) {
+HullDecimation hull_decimation(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Eigen::MatrixXd& P,
+                               double clearance, const HullDecimationOptions& opt, const Progress& progress) {
   HullDecimation out;
   if (opt.target_vertices < 4) {
     out.status = Status::error(StatusCode::InvalidArgument, "hull decimation needs a target of at least 4 vertices");
     return out;
   }
-  if (V.rows() < 4 || F.rows() < 4 || !V.allFinite()) {
+  if (V.rows() < 4 || F.rows() < 4 || !V.allFinite() || !P.allFinite()) {
     out.status = Status::error(StatusCode::InvalidMesh, "hull decimation needs a closed mesh with finite coordinates");
     return out;
   }
@@ -453,11 +537,15 @@ HullDecimation hull_decimation(const Eigen::MatrixXd& V, const Eigen::MatrixXi& 
         out.status = Status::error(StatusCode::InvalidMesh, "face " + std::to_string(f) + " has an invalid vertex index");
         return out;
       }
-  hull_detail::Decimator d(V, F, opt);
+  hull_detail::Decimator d(V, F, P, clearance, opt);
   out.status = d.run(progress, &out.collapses);
   if (!out.status.ok()) return out;
   d.output(&out.V, &out.F);
   progress.update("cage: simplify", 1.0);
+#ifdef MM_HULL_DEBUG
+  for (int i = 0; i < 9; ++i) std::fprintf(stderr, "%d ", hull_detail::g_dbg[i]);
+  std::fprintf(stderr, "\n");
+#endif
   return out;
 }
 

@@ -1,8 +1,14 @@
-// Progressive-hull decimation (Sander, Gu, Gortler, Hoppe, Snyder 2000): edge collapses in
-// quadric-error order (Garland & Heckbert 1997) where the new vertex must lie on the outer side
-// of the planes of all faces around the collapsed edge, so every simplified mesh encloses the
-// previous one and hence the input. The second stage of the automatic cage
-// (cage/enclosing_cage.h).
+// Enclosure-preserving decimation: edge collapses in quadric-error order (Garland & Heckbert
+// 1997) that never let a given set of points leave the surface. The second stage of the
+// automatic cage (cage/enclosing_cage.h).
+//
+// Like the progressive hull (Sander, Gu, Gortler, Hoppe, Snyder 2000) every simplified mesh
+// encloses the points, but the test is made against the points themselves, not against the
+// planes of the previous surface: a collapse is refused when the generalized winding number of
+// a point changes (the change is local: solid angles of the new star minus the old star) or when
+// a new face comes closer than `clearance` to a point. Progressive-hull plane constraints only
+// let the surface grow, which fills every concavity (legs merge, the cage tends to the convex
+// hull); testing the points keeps the cage close to the offset surface.
 //
 // Input: a closed, consistently outward-oriented 2-manifold (e.g. cage/offset_surface.h).
 // Every collapse keeps it a closed 2-manifold (link condition, no vertex of degree < 3), keeps
@@ -35,8 +41,10 @@ struct HullDecimation {
   int collapses = 0;              // collapses performed
 };
 
-// V: #V by 3, F: #F by 3 closed outward-oriented manifold triangles.
+// V: #V by 3, F: #F by 3 closed outward-oriented manifold triangles. P: #P by 3 points to keep
+// inside (may be empty); clearance: distance (mesh units) new faces keep from every point.
 HullDecimation hull_decimation(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                               const Eigen::MatrixXd& P, double clearance,
                                const HullDecimationOptions& opt = {}, const Progress& progress = {});
 
 }  // namespace mm

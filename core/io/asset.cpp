@@ -125,7 +125,7 @@ static Status asset_write_export(const ExportMesh& m, Format format, std::vector
 }
 
 // Everything save_asset and save_asset_to_memory share; `stem` selects sidecar files (.gltf).
-static Status asset_save(const Asset& asset, const Eigen::MatrixXd& V, Format format, const SaveOptions& opt,
+static Status asset_save_impl(const Asset& asset, const Eigen::MatrixXd& V, Format format, const SaveOptions& opt,
                          const std::string& stem, GltfFiles* files) {
   Eigen::MatrixXd V_raw_new;
   std::vector<char> moved;
@@ -164,6 +164,17 @@ static Status asset_save(const Asset& asset, const Eigen::MatrixXd& V, Format fo
   return asset_write_export(m, format, &files->main);
 }
 
+static Status asset_save(const Asset& asset, const Eigen::MatrixXd& V, Format format, const SaveOptions& opt,
+                         const std::string& stem, GltfFiles* files) {
+  try {
+    return asset_save_impl(asset, V, format, opt, stem, files);
+  } catch (const std::bad_alloc&) {
+    return Status::error(StatusCode::IoError, "out of memory while saving");
+  } catch (const std::exception& e) {
+    return Status::error(StatusCode::IoError, std::string("saving failed: ") + e.what());
+  }
+}
+
 static Status asset_check_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Eigen::MatrixXd& colors) {
   if (V.cols() != 3) return Status::error(StatusCode::InvalidArgument, "V must be #V by 3");
   if (F.size() > 0 && F.cols() != 3) return Status::error(StatusCode::InvalidArgument, "F must be #F by 3");
@@ -184,8 +195,9 @@ static Status asset_check_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& 
 
 }  // namespace detail
 
-LoadResult load_asset_from_memory(const std::vector<uint8_t>& bytes, Format format, const std::string& name,
-                                  const FileResolver& resolver, const LoadOptions& opt) {
+namespace detail {
+static LoadResult asset_load(const std::vector<uint8_t>& bytes, Format format, const std::string& name,
+                             const FileResolver& resolver, const LoadOptions& opt) {
   LoadResult r;
   Asset& a = r.asset;
   a.format = format;
@@ -216,6 +228,26 @@ LoadResult load_asset_from_memory(const std::vector<uint8_t>& bytes, Format form
   }
   a.weld = weld_vertices(a.V_raw, a.F_raw, opt.weld);
   return r;
+}
+}  // namespace detail
+
+LoadResult load_asset_from_memory(const std::vector<uint8_t>& bytes, Format format, const std::string& name,
+                                  const FileResolver& resolver, const LoadOptions& opt) {
+  // The readers report data errors as Status; this net catches what only the allocator or a
+  // library can throw (std::bad_alloc on a huge but consistent file), so nothing crosses the API.
+  try {
+    return detail::asset_load(bytes, format, name, resolver, opt);
+  } catch (const std::bad_alloc&) {
+    LoadResult r;
+    r.asset.source_name = name;
+    r.status = Status::error(StatusCode::IoError, name + ": out of memory while loading");
+    return r;
+  } catch (const std::exception& e) {
+    LoadResult r;
+    r.asset.source_name = name;
+    r.status = Status::error(StatusCode::ParseError, name + ": " + e.what());
+    return r;
+  }
 }
 
 LoadResult load_asset(const std::string& path, const LoadOptions& opt) {
@@ -274,7 +306,11 @@ Status save_mesh_to_memory(Format format, const Eigen::MatrixXd& V, const Eigen:
   m.V = V;
   m.F = F.size() > 0 ? F : Eigen::MatrixXi(0, 3);
   m.C = colors;
-  return detail::asset_write_export(m, format, bytes);
+  try {
+    return detail::asset_write_export(m, format, bytes);
+  } catch (const std::exception& e) {
+    return Status::error(StatusCode::IoError, std::string("saving failed: ") + e.what());
+  }
 }
 
 Status save_mesh(const std::string& path, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,

@@ -102,22 +102,30 @@ Status read_gltf_accessor(const tinygltf::Model& model, int index, Eigen::Matrix
   // before allocating.
   if (a.count > (size_t{1} << 31)) return Status::error(StatusCode::ParseError, what + " has an absurd count");
   const uint64_t count = a.count, elem = static_cast<uint64_t>(nc) * cs;
-  out->setZero(static_cast<Eigen::Index>(count), nc);
   Status status;
+  // Bounds first, allocation second: a lying count must not allocate gigabytes.
+  const uint8_t* p = nullptr;
+  uint64_t stride = elem;
   if (a.bufferView >= 0) {
     const int stride_field = model.bufferViews.size() > static_cast<size_t>(a.bufferView)
                                  ? model.bufferViews[a.bufferView].byteStride
                                  : 0;
-    const uint64_t stride = stride_field > 0 ? static_cast<uint64_t>(stride_field) : elem;
+    stride = stride_field > 0 ? static_cast<uint64_t>(stride_field) : elem;
     if (stride < elem)
       return Status::error(StatusCode::ParseError, what + ": byteStride " + std::to_string(stride) +
                                                        " is smaller than the element size " + std::to_string(elem));
-    const uint8_t* p = accessor_view_data(model, a.bufferView, a.byteOffset, count, elem, stride, what, &status);
+    p = accessor_view_data(model, a.bufferView, a.byteOffset, count, elem, stride, what, &status);
     if (!p) return status;
+  } else if (count > (uint64_t{1} << 26)) {
+    // Only sparse data backs an accessor without bufferView; 64M zero elements is not a mesh.
+    return Status::error(StatusCode::ParseError, what + " has no bufferView and an implausible count " +
+                                                     std::to_string(count));
+  }
+  out->setZero(static_cast<Eigen::Index>(count), nc);
+  if (p)
     for (uint64_t i = 0; i < count; ++i)
       for (int c = 0; c < nc; ++c)
         (*out)(static_cast<Eigen::Index>(i), c) = accessor_component(p + i * stride + c * cs, a.componentType, a.normalized);
-  }
   if (a.sparse.isSparse) {
     const uint64_t n = static_cast<uint64_t>(std::max(a.sparse.count, 0));
     if (n > count) return Status::error(StatusCode::ParseError, what + ": sparse count exceeds the accessor count");

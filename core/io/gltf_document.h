@@ -46,4 +46,8 @@ const tinygltf::Model* gltf_model(const Asset& asset);
 // animation export). Images are taken as they are in the model.
 std::shared_ptr<Document> make_gltf_document(tinygltf::Model model);
 
+// Writes a model as .glb (one BIN chunk) or .gltf (buffers as data URIs) bytes with the same
+// buffer and image policy as save_asset (see gltf_serialize.h). IoError when serialization fails.
+Status save_gltf_model_to_memory(const tinygltf::Model& model, Format format, std::vector<uint8_t>* bytes);
+
 }  // namespace mm::io

@@ -245,14 +245,22 @@ Status load_gltf(const std::vector<uint8_t>& bytes, Format format, const FileRes
                  const LoadOptions& opt, Asset* asset) {
   using namespace detail;
   const std::string& name = asset->source_name;
-  const bool binary = format == Format::Glb;
+  // Trust the content over the extension: a .gltf that is really a GLB (or the reverse)
+  // loads as what it is.
+  bool binary = format == Format::Glb;
+  if (bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0) binary = true;
+  else if (binary && !bytes.empty() && (bytes[0] == '{' || (bytes.size() >= 3 && bytes[0] == 0xEF && bytes[1] == 0xBB)))
+    binary = false;
+  asset->format = binary ? Format::Glb : Format::Gltf;
   std::string json_text;
   uint64_t bin_size = 0;
   if (binary) {
     Status s = gltf_glb_json(bytes, name, &json_text, &bin_size);
     if (!s.ok()) return s;
   } else {
-    json_text.assign(bytes.begin(), bytes.end());
+    // A UTF-8 byte order mark is not JSON, but some editors write one.
+    const size_t skip = bytes.size() >= 3 && bytes[0] == 0xEF && bytes[1] == 0xBB && bytes[2] == 0xBF ? 3 : 0;
+    json_text.assign(bytes.begin() + skip, bytes.end());
   }
   auto doc = std::make_shared<GltfDocument>();
   GltfFsContext fs;
@@ -288,6 +296,10 @@ Status load_gltf(const std::vector<uint8_t>& bytes, Format format, const FileRes
     return Status::error(StatusCode::ParseError, name + ": invalid glTF: " + (err.empty() ? "unknown error" : err));
   }
   if (!warn.empty()) asset->warnings.push_back(warn);
+  for (const std::string& ext : model.extensionsRequired)
+    if (ext == "KHR_draco_mesh_compression" || ext == "EXT_meshopt_compression")
+      return Status::error(StatusCode::Unsupported, name + ": the file requires the extension " + ext +
+                                                        " (compressed geometry); export it without compression");
   doc->image_files.resize(model.images.size());
 
   // Roots: the default scene, scene 0, or (no scenes) every node that is nobody's child.

@@ -101,4 +101,16 @@ Status serialize_gltf(tinygltf::Model m, const std::vector<std::vector<uint8_t>>
   return Status::success();
 }
 
+Status save_gltf_model_to_memory(const tinygltf::Model& model, Format format, std::vector<uint8_t>* bytes) {
+  GltfFiles files;
+  Status s;
+  try {
+    s = serialize_gltf(model, {}, format, "", &files);
+  } catch (const std::exception& e) {
+    s = Status::error(StatusCode::IoError, std::string("glTF serialization failed: ") + e.what());
+  }
+  if (s.ok()) *bytes = std::move(files.main);
+  return s;
+}
+
 }  // namespace mm::io

@@ -203,6 +203,8 @@ Status load_ply(const std::vector<uint8_t>& bytes, Asset* asset) {
 
   PlyDataReader data(bytes.data() + data_begin, bytes.size() - data_begin, doc->encoding);
   for (PlyElement& e : doc->elements) {
+    // An element without properties occupies no bytes; looping over its count could hang.
+    if (e.properties.empty()) continue;
     // Refuse counts the remaining bytes cannot hold before allocating anything for them.
     size_t min_row = 0;
     for (const PlyProperty& p : e.properties)

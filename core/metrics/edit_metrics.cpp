@@ -103,7 +103,8 @@ double gradient_shear(const Eigen::Matrix3d& M) {
 Eigen::VectorXd gradient_shear(const Eigen::MatrixXd& G) {
   Eigen::VectorXd out(G.rows());
   for (int i = 0; i < G.rows(); ++i) {
-    const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> M = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(G.row(i).data());
+    const Eigen::Matrix<double, 1, 9> row = G.row(i);  // G is column-major: copy the strided row
+    const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> M = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(row.data());
     out[i] = gradient_shear(Eigen::Matrix3d(M));
   }
   return out;

@@ -6,6 +6,7 @@
 #include <Eigen/SVD>
 
 #include "mesh/mesh.h"
+#include "retarget/bone_correspondence.h"
 #include "retarget/mfs_kernel.h"
 #include "spatial/triangle_bvh.h"
 
@@ -171,6 +172,11 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
     scale_ = (hs > 0.02 && ht > 0.02) ? ht / hs : 1.0;
   }
 
+  // MFS bases.
+  Status s = src_map_.build(Xs, source.F, opt.map, progress.sub(0.0, 0.4));
+  if (!s.ok()) return Status{s.code, "source: " + s.message};
+  s = tgt_map_.build(Xt, target.F, opt.map, progress.sub(0.4, 0.8));
+  if (!s.ok()) return Status{s.code, "target: " + s.message};
   // Descriptor points: joints, then bone-interior samples kept where inside both shapes.
   std::vector<Eigen::RowVector3d> ds, dt;
   for (int i = 0; i < m; ++i) {
@@ -189,6 +195,18 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
       }
     }
   }
+  // Surface descriptors: target surface points (a prefix of the FPS-ordered collocation points)
+  // with their source counterparts in bone coordinates (retarget/bone_correspondence.h).
+  if (opt.surface_descriptors > 0 && !bones_.empty()) {
+    const SurfaceSamples& C = tgt_map_.collocation();
+    const int k = std::min(opt.surface_descriptors, C.size());
+    const BoneCorrespondence bc = bone_correspondence(C.P.topRows(k), bones_, Jt_rest_, Js_rest_, bvh_t, bvh_s);
+    for (int i = 0; i < k; ++i) {
+      if (bc.bone[i] < 0) continue;
+      ds.push_back(bc.X.row(i));
+      dt.push_back(C.P.row(i));
+    }
+  }
   Xs_desc_.resize(ds.size(), 3);
   Xt_desc_.resize(dt.size(), 3);
   for (size_t i = 0; i < ds.size(); ++i) {
@@ -196,11 +214,6 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
     Xt_desc_.row(i) = dt[i];
   }
 
-  // MFS bases.
-  Status s = src_map_.build(Xs, source.F, opt.map, progress.sub(0.0, 0.4));
-  if (!s.ok()) return Status{s.code, "source: " + s.message};
-  s = tgt_map_.build(Xt, target.F, opt.map, progress.sub(0.4, 0.8));
-  if (!s.ok()) return Status{s.code, "target: " + s.message};
   if (!progress.update("synthesis", 0.8)) return cancelled_status("synthesis");
   const Eigen::MatrixXd& Q = src_map_.singularities();
   const Eigen::MatrixXd& U = tgt_map_.singularities();

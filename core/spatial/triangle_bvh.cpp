@@ -217,6 +217,37 @@ int TriangleBvh::ray_winding(const Eigen::Vector3d& p, const Eigen::Vector3d& di
   return winding;
 }
 
+double TriangleBvh::ray_first_hit(const Eigen::Vector3d& p, const Eigen::Vector3d& dir, double max_s) const {
+  if (nodes_.empty()) return -1;
+  const Eigen::Vector3d inv = dir.cwiseInverse();
+  double best = max_s;
+  bool hit = false;
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& n = nodes_[stack[--top]];
+    if (!spatial_detail::ray_hits_box(p, inv, best, n.lo, n.hi)) continue;
+    if (n.count > 0) {
+      for (int i = n.first; i < n.first + n.count; ++i) {
+        const int f = order_[i];
+        int sign = 0;
+        const double t = spatial_detail::ray_triangle(p, dir, V_.row(F_(f, 0)).transpose(),
+                                                      V_.row(F_(f, 1)).transpose(),
+                                                      V_.row(F_(f, 2)).transpose(), &sign);
+        if (t > 1e-12 && t <= best) {
+          best = t;
+          hit = true;
+        }
+      }
+      continue;
+    }
+    stack[top++] = n.left;
+    stack[top++] = n.right;
+  }
+  return hit ? best : -1;
+}
+
 bool TriangleBvh::inside(const Eigen::Vector3d& p) const {
   // Irrational-ish fixed directions so that rays rarely graze edges of axis-aligned models.
   static const double dirs[7][3] = {{0.5366, 0.7071, 0.4603},  {-0.6247, 0.3312, -0.7071},

@@ -47,6 +47,11 @@ class TriangleBvh {
   // overlapping closed parts add up.
   int ray_winding(const Eigen::Vector3d& p, const Eigen::Vector3d& dir) const;
 
+  // Distance s > 0 to the first triangle hit by the ray p + s·dir (dir need not be unit; s
+  // is in units of dir), or -1 when nothing is hit within s ≤ max_s.
+  double ray_first_hit(const Eigen::Vector3d& p, const Eigen::Vector3d& dir,
+                       double max_s = std::numeric_limits<double>::infinity()) const;
+
   // Inside test robust to small holes and to inverted parts: casts 7 fixed rays and says
   // "inside" when most of them see |winding| ≥ 1.
   bool inside(const Eigen::Vector3d& p) const;

@@ -1,6 +1,7 @@
 // Browser end-to-end tests of the page: playwright-core drives Debian's /usr/bin/chromium
-// (headless, WebGL through SwiftShader) against the built page (build/web-dist, built here
-// if missing or when MM_E2E_BUILD=1) served by `vite preview` on 127.0.0.1 and a free port.
+// (headless, WebGL through SwiftShader) against the built page (build/web-dist; rebuilt here
+// when missing, older than web/ or the wasm module, or MM_E2E_BUILD=1) served by `vite
+// preview` on 127.0.0.1 and a free port.
 // Screenshots go to build/e2e/. Prints "N passed, M failed"; exit code 1 on any failure.
 //
 // Usage: node tests/e2e/run.mjs [--headed] [--only <substring>]
@@ -333,9 +334,27 @@ it('gallery: every sample loads and renders', async ({ page }) => {
 
 // ---- runner
 
+// True when build/web-dist is missing or older than the page sources or the wasm module.
+function pageIsStale() {
+  const built = path.join(distDir, 'index.html');
+  if (!fs.existsSync(built)) return true;
+  const builtAt = fs.statSync(built).mtimeMs;
+  const wasmDir = path.resolve(repoDir, process.env.MM_WASM_DIR || 'build/wasm/wasm');
+  const inputs = [path.join(wasmDir, 'meshmorph_web.mjs'), path.join(wasmDir, 'meshmorph_web.wasm')];
+  const walk = (dir) => {
+    for (const entry of fs.readdirSync(dir, { withFileTypes: true })) {
+      const full = path.join(dir, entry.name);
+      if (entry.isDirectory()) walk(full);
+      else inputs.push(full);
+    }
+  };
+  walk(path.join(repoDir, 'web'));
+  return inputs.some((f) => fs.existsSync(f) && fs.statSync(f).mtimeMs > builtAt);
+}
+
 async function main() {
   fs.mkdirSync(shotDir, { recursive: true });
-  if (process.env.MM_E2E_BUILD === '1' || !fs.existsSync(path.join(distDir, 'index.html'))) {
+  if (process.env.MM_E2E_BUILD === '1' || pageIsStale()) {
     console.log('building the page (vite build)…');
     await build({ configFile, logLevel: 'warn' });
   }
@@ -361,11 +380,15 @@ async function main() {
     const page = context.pages()[0] || (await context.newPage());
     const pageErrors = [];
     page.on('pageerror', (e) => pageErrors.push(e.message));
-    page.on('console', (m) => { if (m.type() === 'error' || m.type() === 'warning') console.log(`    [page ${m.type()}] ${m.text()}`); });
+    // Console output is shown for failed tests only: the page logs every error it displays,
+    // and the malformed-file test provokes several on purpose.
+    let consoleLines = [];
+    page.on('console', (m) => { if (m.type() === 'error' || m.type() === 'warning') consoleLines.push(`[page ${m.type()}] ${m.text()}`); });
     await page.goto(baseUrl);
     for (const t of tests) {
       if (only && !t.name.includes(only)) continue;
       const started = Date.now();
+      consoleLines = [];
       try {
         await t.fn({ page, context, baseUrl, pageErrors });
         passed += 1;
@@ -373,6 +396,7 @@ async function main() {
       } catch (e) {
         failed += 1;
         console.log(`FAIL ${t.name} (${Date.now() - started} ms)\n     ${String(e.message || e).split('\n').join('\n     ')}`);
+        for (const line of consoleLines) console.log(`     ${line}`);
         await shot(page, `fail-${tests.indexOf(t)}`).catch(() => {});
       }
     }

@@ -106,20 +106,42 @@ export class Viewer {
     this.requestRender();
   }
 
-  // Looks at the bounding sphere from the front, slightly above, so that the whole mesh fits
-  // the narrower side of the view.
+  // Looks at the mesh from the front, slightly above, at the distance where it fills ~85% of
+  // the narrower side of the view. The fit uses the vertices themselves: a bounding sphere or
+  // box seen obliquely frames most shapes far too small.
   frame() {
     const sphere = this.geometry.boundingSphere;
+    const box = this.geometry.boundingBox;
     if (!sphere || !(sphere.radius > 0)) return;
-    const vFov = THREE.MathUtils.degToRad(this.camera.fov);
-    const hFov = 2 * Math.atan(Math.tan(vFov / 2) * this.camera.aspect);
-    const distance = (sphere.radius / Math.sin(Math.min(vFov, hFov) / 2)) * 1.08;
+    const tanY = Math.tan(THREE.MathUtils.degToRad(this.camera.fov) / 2) * 0.85;
+    const tanX = tanY * this.camera.aspect;
     const direction = new THREE.Vector3(0.35, 0.25, 1).normalize();
+    const center = box.getCenter(new THREE.Vector3());
+    // Start from the sphere's distance, then move along the view axis until every vertex is
+    // inside the (shrunk) frustum: a point at camera-space (x, y, z) needs depth
+    // max(|x|/tanX, |y|/tanY), and moving back by Δ adds Δ to every depth.
+    let distance = sphere.radius / Math.sin(Math.atan(Math.min(tanX, tanY)));
+    this.camera.position.copy(center).addScaledVector(direction, distance);
+    this.camera.lookAt(center);
+    this.camera.updateMatrixWorld();
+    const m = this.camera.matrixWorldInverse.elements;
+    const p = this.geometry.getAttribute('position').array;
+    let shift = -Infinity;
+    for (let i = 0; i < p.length; i += 3) {
+      const x = m[0] * p[i] + m[4] * p[i + 1] + m[8] * p[i + 2] + m[12];
+      const y = m[1] * p[i] + m[5] * p[i + 1] + m[9] * p[i + 2] + m[13];
+      const z = m[2] * p[i] + m[6] * p[i + 1] + m[10] * p[i + 2] + m[14];
+      const need = Math.max(Math.abs(x) / tanX, Math.abs(y) / tanY) + z;
+      if (need > shift) shift = need;
+    }
+    distance += shift;
+    // Clip planes and zoom range follow the mesh's scale (files come in mm or in m).
     this.camera.near = distance / 100;
-    this.camera.far = distance * 10;
-    this.camera.position.copy(sphere.center).addScaledVector(direction, distance);
+    this.camera.far = distance * 20;
+    this.controls.maxDistance = distance * 8;
+    this.camera.position.copy(center).addScaledVector(direction, distance);
     this.camera.updateProjectionMatrix();
-    this.controls.target.copy(sphere.center);
+    this.controls.target.copy(center);
     this.controls.update();
     this.requestRender();
   }

@@ -1,0 +1,79 @@
+#include "retarget/bone_correspondence.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+namespace mm {
+
+namespace retarget_detail {
+
+// Minimal rotation taking unit vector a to unit vector b.
+Eigen::Matrix3d rotation_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return Eigen::Quaterniond::FromTwoVectors(a, b).toRotationMatrix();
+}
+
+}  // namespace retarget_detail
+
+BoneCorrespondence bone_correspondence(const Eigen::MatrixXd& Y, const std::vector<std::pair<int, int>>& bones,
+                                       const Eigen::MatrixXd& Jt, const Eigen::MatrixXd& Js,
+                                       const TriangleBvh& bvh_t, const TriangleBvh& bvh_s) {
+  BoneCorrespondence r;
+  const int n = static_cast<int>(Y.rows()), nb = static_cast<int>(bones.size());
+  r.X = Y;
+  r.bone = Eigen::VectorXi::Constant(n, -1);
+  r.u = Eigen::VectorXd::Zero(n);
+  if (nb == 0) return r;
+  std::vector<Eigen::Matrix3d> Rb(nb);
+  for (int b = 0; b < nb; ++b) {
+    const Eigen::Vector3d dt = (Jt.row(bones[b].first) - Jt.row(bones[b].second)).transpose();
+    const Eigen::Vector3d ds = (Js.row(bones[b].first) - Js.row(bones[b].second)).transpose();
+    Rb[b] = retarget_detail::rotation_between(dt.normalized(), ds.normalized());
+  }
+  std::vector<std::pair<double, int>> order(nb);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d y = Y.row(i).transpose();
+    std::vector<double> ub(nb);
+    std::vector<Eigen::Vector3d> qb(nb);
+    for (int b = 0; b < nb; ++b) {
+      const Eigen::Vector3d p = Jt.row(bones[b].second).transpose(), c = Jt.row(bones[b].first).transpose();
+      const Eigen::Vector3d d = c - p;
+      ub[b] = std::clamp((y - p).dot(d) / std::max(1e-300, d.squaredNorm()), 0.0, 1.0);
+      qb[b] = p + ub[b] * d;
+      order[b] = {(y - qb[b]).squaredNorm(), b};
+    }
+    std::sort(order.begin(), order.end());
+    // The nearest bone that sees y: the segment bone point → y (stopped just short of y, which
+    // lies on the surface) must not cross the surface. Only the 4 nearest are tried.
+    int pick = order[0].second;
+    for (int k = 0; k < std::min(nb, 4); ++k) {
+      const int b = order[k].second;
+      const Eigen::Vector3d end = qb[b] + 0.98 * (y - qb[b]);
+      if (!bvh_t.segment_hits(qb[b], end)) {
+        pick = b;
+        break;
+      }
+    }
+    const Eigen::Vector3d o = y - qb[pick];
+    const double len = o.norm();
+    const Eigen::Vector3d ps = Js.row(bones[pick].second).transpose(), cs = Js.row(bones[pick].first).transpose();
+    const Eigen::Vector3d qs = ps + ub[pick] * (cs - ps);
+    r.bone[i] = pick;
+    r.u[i] = ub[pick];
+    if (len < 1e-12) {
+      r.X.row(i) = qs.transpose();
+      continue;
+    }
+    const Eigen::Vector3d dir = Rb[pick] * (o / len);
+    // Radii along the direction on both shapes: the point keeps its fraction of the radius.
+    const double rt = bvh_t.ray_first_hit(qb[pick], o / len, 4 * len);
+    const double rs = bvh_s.ray_first_hit(qs, dir, 8 * len);
+    const double frac = rt > 0 ? std::min(1.0, len / rt) : 1.0;
+    const double radius = rs > 0 ? rs : len;
+    r.X.row(i) = (qs + dir * frac * radius).transpose();
+  }
+  return r;
+}
+
+}  // namespace mm

@@ -1,0 +1,123 @@
+// Types of the wasm module's JS API (wasm/bind_*.cpp), the worker protocol (protocol.js) and
+// the mesh ops (ops/mesh.js). Documentation only: the page is plain JS, editors and
+// reviewers read this. Engineers adding bind_<module>.cpp / ops/<module>.js extend
+// MeshMorphModule and add their op types below.
+
+/** Every binding failure; the JS wrapper (errors.js unwrap) throws MeshMorphError with it. */
+export interface Failure {
+  ok: false;
+  /** StatusCode name (core/common/status.h): InvalidArgument, InvalidMesh, IoError, ParseError,
+   *  Unsupported, FactorizationFailed, NotConverged, NumericalError, Cancelled; or Internal
+   *  (a C++ exception escaped: a bug or out of memory). */
+  code: string;
+  /** A sentence a user can act on, e.g. "mesh has 12 non-manifold edges, first at vertices 10-11". */
+  message: string;
+}
+export type Result<T> = ({ ok: true } & T) | Failure;
+
+export interface DefectReport {
+  id: 'Empty' | 'NonFiniteCoordinate' | 'IndexOutOfRange' | 'DegenerateFace' | 'DuplicateFace'
+    | 'NonManifoldEdge' | 'NonManifoldVertex' | 'UnreferencedVertex' | 'InconsistentOrientation';
+  name: string;     // human wording, as in `meshmorph info`
+  count: number;
+  example: string;  // first instance, e.g. "face 17 (vertices 3, 3, 9)"
+}
+
+/** core/mesh/validate.h MeshReport. */
+export interface MeshReport {
+  vertices: number; faces: number; edges: number;
+  bboxMin: [number, number, number]; bboxMax: [number, number, number]; bboxDiagonal: number;
+  components: number; componentSizes: number[];
+  boundaryLoopLengths: number[]; eulerCharacteristic: number; closed: boolean;
+  defects: DefectReport[];
+}
+
+export interface PrimitiveInfo {
+  name: string; node: number; mesh: number; primitive: number;
+  firstVertex: number; numVertices: number; firstFace: number; numFaces: number; skinned: boolean;
+}
+
+/** io::LoadOptions with C++ field names; every field optional (core defaults). */
+export interface LoadOptions {
+  weld?: { tolerance?: number; drop_degenerate_faces?: boolean };
+  skip_unsupported_primitives?: boolean;
+}
+
+/** core/spectral/spectral_basis.h SpectralBasisOptions. */
+export interface SpectralBasisOptions {
+  k?: number; ncv?: number; relative_shift?: number; tolerance?: number; max_iterations?: number;
+}
+
+/** The Emscripten module (meshmorph_web.mjs in the worker, meshmorph_node.cjs in tests).
+ *  Embind checks argument counts: pass `undefined` for an optional argument, never omit it. */
+export interface MeshMorphModule {
+  /** Loads a file by its name's extension (.glb .gltf .obj .off .ply). `files` resolves a
+   *  .gltf's external URIs (exact key, then last path segment). The asset stays registered
+   *  until disposeAsset. */
+  loadAsset(bytes: Uint8Array, name: string, files: Record<string, Uint8Array> | undefined,
+            options: LoadOptions | undefined): Result<{
+    asset: number; name: string; format: string; warnings: string[]; primitives: PrimitiveInfo[];
+    positions: Float32Array;      // #R·3, raw layout, world space
+    indices: Uint32Array;         // #T·3 over the raw layout
+    normals: Float32Array;        // #R·3, smooth normals of the welded surface
+    toWelded: Uint32Array;        // #R, welded index of every raw vertex
+    weldedPositions: Float64Array; // #W·3
+    weldedIndices: Uint32Array;   // #F·3 over welded vertices
+    report: MeshReport;           // of the welded mesh
+    text: string;                 // `meshmorph info` text (io/info_report.h)
+    info: object;                 // `meshmorph info --json`
+  }>;
+  disposeAsset(asset: number): boolean;
+  /** Writes the asset (everything in the document kept) with new welded positions (#W·3) or
+   *  the loaded ones (undefined). format: 'glb' | 'gltf' | 'obj' | 'off' | 'ply'. */
+  exportAsset(asset: number, positions: Float64Array | Float32Array | undefined, format: string,
+              options: { recompute_normals?: boolean } | undefined): Result<{ bytes: Uint8Array }>;
+  /** A plain mesh (no source document), optional colours #V·3 in 0..1. */
+  saveMesh(format: string, positions: Float64Array | Float32Array, indices: Uint32Array,
+           colors: Float32Array | Float64Array | undefined): Result<{ bytes: Uint8Array }>;
+  validateMesh(positions: Float64Array | Float32Array, indices: Uint32Array,
+               options: { degenerate_area_tolerance?: number } | undefined): Result<{ report: MeshReport; text: string }>;
+  /** k smallest eigenpairs of Wφ = λAφ. progress returns false to cancel (code Cancelled).
+   *  Refuses non-manifold input (InvalidMesh) like `meshmorph eigs`. */
+  spectralBasis(positions: Float64Array | Float32Array, indices: Uint32Array,
+                options: SpectralBasisOptions | undefined,
+                progress: ((stage: string, fraction: number) => boolean) | undefined): Result<{
+    eigenvalues: Float64Array;  // k, ascending
+    vectors: Float32Array;      // k·#V, function i at [i·#V, (i+1)·#V)
+    iterations: number; operations: number;
+  }>;
+}
+
+// ---- worker protocol (protocol.js)
+
+export type Buffers = Record<string, ArrayBufferView | ArrayBuffer>;
+export type ToWorker =
+  | { type: 'init'; cancelFlag?: Int32Array /* over a SharedArrayBuffer */ }
+  | { type: 'run'; id: number; op: string; options: object; buffers: Buffers }
+  | { type: 'cancel'; id: number };
+export type FromWorker =
+  | { type: 'ready'; ops: string[]; cooperativeCancel: boolean }
+  | { type: 'progress'; id: number; stage: string; fraction: number }
+  | { type: 'result'; id: number; buffers: Buffers; info: object }
+  | { type: 'error'; id: number | null; code: string; message: string; fatal?: boolean };
+
+/** What an op receives (ops/<module>.js). */
+export interface OpContext {
+  module: MeshMorphModule;
+  state: { meshes: Map<string, { asset: number; name: string; format: string;
+    weldedPositions: Float64Array; weldedIndices: Uint32Array; toWelded: Uint32Array }> } & Record<string, unknown>;
+  /** Forward to core progress callbacks; false means the user cancelled. */
+  progress(stage: string, fraction: number): boolean;
+}
+export type Op = (ctx: OpContext, options: object, buffers: Buffers) => { buffers?: Buffers; info?: object };
+
+// ---- mesh ops (ops/mesh.js): options → result buffers / info
+// load     {name, slot?, weld?, skip_unsupported_primitives?} + buffers {[name]: bytes, [sibling]: bytes}
+//          → {positions, indices, normals, toWelded} / {slot, name, format, warnings, primitives,
+//            report, text, infoReport, rawVertices, weldedVertices}
+// validate {slot?} or buffers {positions, indices} → {} / {slot, report, text}
+// eigs     {slot?, k?, ncv?, relative_shift?, tolerance?, max_iterations?}
+//          → {eigenvalues, vectors} / {slot, k, weldedVertices, iterations, operations, milliseconds}
+// export   {slot?, format? = 'glb', recompute_normals?} + buffers {positions?}
+//          → {bytes} / {fileName, format, byteLength}
+// unload   {slot?} → {} / {slot, unloaded}
