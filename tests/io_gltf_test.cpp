@@ -371,6 +371,7 @@ TEST(IoGltf, ImagesSurviveRoundTrips) {
   // .gltf -> GLB: the PNG is embedded byte for byte.
   std::vector<uint8_t> glb;
   ASSERT_TRUE(mm::io::save_asset_to_memory(r.asset, W, Format::Glb, &glb).ok());
+  ASSERT_TRUE(mm::io::save_asset(r.asset, W, scratch_path("roundtrip_fox_from_gltf.glb")).ok());
   const auto g = mm::io::load_asset_from_memory(glb, Format::Glb, "fox.glb");
   ASSERT_TRUE(g.status.ok()) << g.status.message;
   const tinygltf::Model& m = *mm::io::gltf_model(g.asset);
@@ -547,4 +548,44 @@ TEST(IoGltf, PathTraversalRefusedBeforeTheResolverIsAsked) {
       });
   EXPECT_TRUE(fine.status.ok()) << fine.status.message;
   EXPECT_EQ(asked_for, "textures/a b.png");
+}
+
+TEST(IoGltf, ContentDecidesBetweenGltfAndGlb) {
+  std::vector<uint8_t> glb;
+  ASSERT_TRUE(mm::io::read_file(tests_path("bad/triangle_ok.glb"), &glb).ok());
+  const auto a = mm::io::load_asset_from_memory(glb, Format::Gltf, "really_binary.gltf");
+  ASSERT_TRUE(a.status.ok()) << a.status.message;
+  EXPECT_EQ(a.asset.format, Format::Glb);
+  const std::string text = "\xEF\xBB\xBF" + gltf_test_triangle_gltf(nlohmann::json::object());
+  const auto b = mm::io::load_asset_from_memory(gltf_test_bytes(text), Format::Glb, "really_text.glb");
+  ASSERT_TRUE(b.status.ok()) << b.status.message;
+  EXPECT_EQ(b.asset.format, Format::Gltf);
+}
+
+TEST(IoGltf, CompressedGeometryIsUnsupported) {
+  const std::string text = gltf_test_triangle_gltf(
+      {{"extensionsUsed", {"KHR_draco_mesh_compression"}}, {"extensionsRequired", {"KHR_draco_mesh_compression"}}});
+  const auto r = mm::io::load_asset_from_memory(gltf_test_bytes(text), Format::Gltf, "draco.gltf");
+  EXPECT_EQ(r.status.code, StatusCode::Unsupported);
+  EXPECT_NE(r.status.message.find("KHR_draco_mesh_compression"), std::string::npos) << r.status.message;
+}
+
+TEST(IoGltf, ModelSavedDirectlyForExporters) {
+  const auto r = mm::io::load_asset(data_path("anim/CesiumMan/CesiumMan.glb"));
+  ASSERT_TRUE(r.status.ok());
+  tinygltf::Model m = *mm::io::gltf_model(r.asset);
+  m.nodes[0].name = "renamed by an exporter";
+  std::vector<uint8_t> bytes;
+  ASSERT_TRUE(mm::io::save_gltf_model_to_memory(m, Format::Glb, &bytes).ok());
+  const auto back = mm::io::load_asset_from_memory(bytes, Format::Glb, "exported.glb");
+  ASSERT_TRUE(back.status.ok()) << back.status.message;
+  EXPECT_EQ(mm::io::gltf_model(back.asset)->nodes[0].name, "renamed by an exporter");
+  EXPECT_EQ(back.asset.V_raw, r.asset.V_raw);
+  // make_gltf_document gives an Asset that save_asset writes unchanged.
+  mm::io::Asset a;
+  a.format = Format::Glb;
+  a.document = mm::io::make_gltf_document(m);
+  std::vector<uint8_t> again;
+  ASSERT_TRUE(mm::io::save_asset_to_memory(a, Eigen::MatrixXd(0, 3), Format::Glb, &again).ok());
+  EXPECT_TRUE(again == bytes);
 }

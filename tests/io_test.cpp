@@ -388,3 +388,20 @@ TEST(IoConvert, SaveMeshGlbWithColorsValidates) {
   // Without colors, too.
   ASSERT_TRUE(mm::io::save_mesh(scratch_path("save_mesh_bar.glb"), V, r.asset.weld.F).ok());
 }
+
+TEST(IoConvert, GltfToObjKeepsUVsAndRawLayout) {
+  const auto r = mm::io::load_asset(data_path("anim/Fox/glTF-Binary/Fox.glb"));
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
+  const std::string out = scratch_path("fox_from_glb.obj");
+  ASSERT_TRUE(mm::io::save_asset(r.asset, r.asset.weld.V, out).ok());
+  const auto back = mm::io::load_asset(out);
+  ASSERT_TRUE(back.status.ok()) << back.status.message;
+  EXPECT_EQ(back.asset.V_raw, r.asset.V_raw);  // float values print and parse exactly
+  EXPECT_EQ(back.asset.F_raw, r.asset.F_raw);
+  EXPECT_EQ(back.asset.weld.V.rows(), 290);
+  std::vector<uint8_t> text;
+  ASSERT_TRUE(mm::io::read_file(out, &text).ok());
+  const std::string s(text.begin(), text.end());
+  EXPECT_NE(s.find("\nvt "), std::string::npos);
+  EXPECT_NE(s.find("\nf 1/1 2/2 3/3\n"), std::string::npos);
+}

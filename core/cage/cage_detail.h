@@ -38,8 +38,9 @@ inline Vec3 area_vector(const Vec3& a, const Vec3& b, const Vec3& c) { return cr
 // Squared distance from p to triangle (a, b, c) (Ericson, Real-Time Collision Detection 5.1.5).
 double point_triangle_distance2(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
-// True when the closed segments/triangles intersect. Triangles sharing a vertex are the
-// caller's business (they always touch). Coplanar overlaps are reported as intersecting.
+// True when the triangles cross properly (an edge of one passes through the interior of the
+// other, beyond a relative epsilon). Touching, coplanar contact and zero-area triangles are not
+// reported: the test guards the cage against folding into itself, where exact contact is noise.
 bool triangles_intersect(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
                          const Vec3& b1, const Vec3& b2);
 

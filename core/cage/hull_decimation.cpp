@@ -3,9 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <iterator>
-#include <queue>
 #include <vector>
 
 #include "cage/cage_detail.h"
@@ -13,12 +11,6 @@
 namespace mm {
 
 namespace hull_detail {
-#ifdef MM_HULL_DEBUG
-int g_dbg[10];
-#define DBG(i) (++g_dbg[i])
-#else
-#define DBG(i) ((void)0)
-#endif
 
 using cage_detail::Vec3;
 using cage_detail::cross;
@@ -62,14 +54,53 @@ struct Quadric {
 
 struct HeapEntry {
   double cost;
-  int a, b;            // a < b
-  unsigned va, vb;     // versions of a and b when the entry was made
-  // std::priority_queue is a max-heap: "less" means "collapsed later".
-  bool operator<(const HeapEntry& o) const {
-    if (cost != o.cost) return cost > o.cost;
-    if (a != o.a) return a > o.a;
-    return b > o.b;
+  int a, b;  // a < b
+  // Priority: lower cost first, ties by vertex indices (deterministic).
+  bool before(const HeapEntry& o) const {
+    if (cost != o.cost) return cost < o.cost;
+    if (a != o.a) return a < o.a;
+    return b < o.b;
   }
+};
+
+// 4-ary min-heap of 16-byte entries. Edge collapses leave many stale entries behind, and a
+// binary heap of that size spends most of its time in cache misses; four children per node
+// halve the depth and share cache lines.
+class EdgeHeap {
+ public:
+  bool empty() const { return h_.empty(); }
+  void push(const HeapEntry& e) {
+    size_t i = h_.size();
+    h_.push_back(e);
+    while (i > 0) {
+      const size_t parent = (i - 1) / 4;
+      if (!h_[i].before(h_[parent])) break;
+      std::swap(h_[i], h_[parent]);
+      i = parent;
+    }
+  }
+  HeapEntry pop() {
+    const HeapEntry top = h_[0];
+    h_[0] = h_.back();
+    h_.pop_back();
+    const size_t n = h_.size();
+    size_t i = 0;
+    for (;;) {
+      const size_t first = 4 * i + 1;
+      if (first >= n) break;
+      size_t best = first;
+      const size_t last = std::min(first + 4, n);
+      for (size_t c = first + 1; c < last; ++c)
+        if (h_[c].before(h_[best])) best = c;
+      if (!h_[best].before(h_[i])) break;
+      std::swap(h_[i], h_[best]);
+      i = best;
+    }
+    return top;
+  }
+
+ private:
+  std::vector<HeapEntry> h_;
 };
 
 struct Candidates {
@@ -163,7 +194,6 @@ class Decimator {
     vf_.resize(n);
     quadric_.resize(n);
     vert_alive_.assign(n, 0);
-    version_.assign(n, 0);
     for (int f = 0; f < F.rows(); ++f) {
       faces_[f] = {F(f, 0), F(f, 1), F(f, 2)};
       for (int c = 0; c < 3; ++c) {
@@ -195,15 +225,12 @@ class Decimator {
     const int start = alive_vertices_;
     int done = 0;
     while (alive_vertices_ > opt_.target_vertices && !heap_.empty()) {
-      const HeapEntry e = heap_.top();
-      heap_.pop();
-      if (!vert_alive_[e.a] || !vert_alive_[e.b] || version_[e.a] != e.va || version_[e.b] != e.vb) continue;
+      const HeapEntry e = heap_.pop();
+      if (!vert_alive_[e.a] || !vert_alive_[e.b]) continue;
+      // The cost depends only on the state of a and b; when either changed, a fresh entry was
+      // pushed and this one is stale (a different cost). An equal cost describes the present.
       const Candidates c = candidates(e.a, e.b);
-      if (c.n == 0) continue;
-      if (c.cost[0] > e.cost + 1e-12 * std::abs(e.cost) + 1e-300) {
-        heap_.push({c.cost[0], e.a, e.b, e.va, e.vb});  // neighbourhood changed since: re-queue
-        continue;
-      }
+      if (c.n == 0 || c.cost[0] != e.cost) continue;
       if (!collapse(e.a, e.b, c)) continue;
       ++done;
       if (alive_faces_ * 2 < grid_faces_) rebuild_grid();
@@ -303,7 +330,7 @@ class Decimator {
 
   void push(int a, int b) {
     const Candidates c = candidates(a, b);
-    if (c.n > 0) heap_.push({c.cost[0], a, b, version_[a], version_[b]});
+    if (c.n > 0) heap_.push({c.cost[0], a, b});
   }
 
   bool collapse(int a, int b, const Candidates& cands) {
@@ -311,7 +338,7 @@ class Decimator {
     std::vector<int> edge_faces;
     for (int f : faces_of(a))
       if (has_vertex(faces_[f], b)) edge_faces.push_back(f);
-    if (edge_faces.size() != 2) { DBG(0); return false; }
+    if (edge_faces.size() != 2) return false;
     int opposite[2];
     for (int k = 0; k < 2; ++k) {
       const auto& t = faces_[edge_faces[k]];
@@ -321,10 +348,10 @@ class Decimator {
     const std::vector<int> na = neighbours(a), nb = neighbours(b);
     std::vector<int> common;
     std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
-    if (common.size() != 2) { DBG(1); return false; }
-    if (static_cast<int>(na.size() + nb.size()) - 4 < 3) { DBG(2); return false; }
+    if (common.size() != 2) return false;
+    if (static_cast<int>(na.size() + nb.size()) - 4 < 3) return false;
     for (int k = 0; k < 2; ++k)
-      if (neighbours(opposite[k]).size() <= 3) { DBG(3); return false; }
+      if (neighbours(opposite[k]).size() <= 3) return false;
 
     const std::vector<int> s = star(a, b);
     for (int k = 0; k < cands.n; ++k)
@@ -341,6 +368,8 @@ class Decimator {
     std::vector<std::array<Vec3, 3>> moved, old;
     std::vector<std::array<int, 3>> moved_ids;
     Vec3 lo = p, hi = p;
+    double largest = 0;
+    for (int f : s) largest = std::max(largest, norm(face_area_vector(f)));
     for (int f : s) {
       const auto& t = faces_[f];
       const std::array<Vec3, 3> O = {pos_[t[0]], pos_[t[1]], pos_[t[2]]};
@@ -360,14 +389,15 @@ class Decimator {
       const Vec3 old_n = cage_detail::area_vector(O[0], O[1], O[2]);
       const Vec3 new_n = cage_detail::area_vector(P[0], P[1], P[2]);
       const double lo_n = norm(old_n), ln = norm(new_n);
-      if (!(ln > 1e-12 * lo_n) || !(ln > 0)) { DBG(4); return false; }
-      if (lo_n > 0 && dot(old_n, new_n) < cos_turn_ * lo_n * ln) { DBG(5); return false; }
+      if (!(ln > 1e-12 * lo_n) || !(ln > 0)) return false;
+      // Slivers (the offset surface has many) have meaningless normals: no turn test for them.
+      if (lo_n > 1e-2 * largest && dot(old_n, new_n) < cos_turn_ * lo_n * ln) return false;
       moved.push_back(P);
       moved_ids.push_back(ids);
     }
-    if (opt_.check_self_intersections)
-      for (size_t k = 0; k < moved.size(); ++k)
-        if (hits_other_face(moved[k], moved_ids[k], a, b)) { DBG(6); return false; }
+    if (opt_.check_self_intersections && hits_other_face(moved, moved_ids, a, b)) {
+      return false;
+    }
     // Points: the winding number changes only inside the region swept between the old and the
     // new star, which lies in the bounding box of their vertices.
     const Vec3 pad(clearance_, clearance_, clearance_);
@@ -375,11 +405,10 @@ class Decimator {
     return points_.for_each_in_box(lo - pad, hi + pad, [&](const Vec3& x) {
       double delta = 0;
       for (const auto& P : moved) {
-        if (clearance_ > 0 && cage_detail::point_triangle_distance2(x, P[0], P[1], P[2]) < c2) { DBG(7); return false; }
+        if (clearance_ > 0 && cage_detail::point_triangle_distance2(x, P[0], P[1], P[2]) < c2) return false;
         delta += hull_solid_angle(x, P[0], P[1], P[2]);
       }
       for (const auto& O : old) delta -= hull_solid_angle(x, O[0], O[1], O[2]);
-      if (std::abs(delta) >= 2 * kPi) DBG(8);
       return std::abs(delta) < 2 * kPi;
     });
   }
@@ -397,8 +426,6 @@ class Decimator {
     vf_[b].clear();
     vert_alive_[b] = 0;
     --alive_vertices_;
-    ++version_[a];
-    ++version_[b];
     auto& list = vf_[a];
     std::sort(list.begin(), list.end());
     list.erase(std::unique(list.begin(), list.end()), list.end());
@@ -461,16 +488,29 @@ class Decimator {
       for (int y = r0[1]; y <= r1[1]; ++y)
         for (int x = r0[0]; x <= r1[0]; ++x) {
           auto& cell = cells_[x + static_cast<size_t>(dims_[0]) * (y + static_cast<size_t>(dims_[1]) * z)];
-          // Drop stale entries now and then so cells do not grow without bound.
-          if (cell.size() >= 32 && (cell.size() & (cell.size() - 1)) == 0)
+          // Faces are re-inserted after every change: drop dead entries and duplicates whenever
+          // a cell doubles so cells stay short.
+          if (cell.size() >= 16 && (cell.size() & (cell.size() - 1)) == 0) {
+            std::sort(cell.begin(), cell.end());
+            cell.erase(std::unique(cell.begin(), cell.end()), cell.end());
             cell.erase(std::remove_if(cell.begin(), cell.end(), [&](int g) { return !face_alive_[g]; }), cell.end());
+          }
           cell.push_back(f);
         }
   }
 
-  bool hits_other_face(const std::array<Vec3, 3>& P, const std::array<int, 3>& ids, int a, int b) {
+  // True when one of the moved faces crosses a face that shares no vertex with it. One grid
+  // query over the bounding box of all moved faces collects the candidates.
+  bool hits_other_face(const std::vector<std::array<Vec3, 3>>& moved, const std::vector<std::array<int, 3>>& ids,
+                       int a, int b) {
+    if (moved.empty()) return false;
+    std::vector<Vec3> mlo(moved.size()), mhi(moved.size());
     Vec3 lo, hi;
-    bbox(P, &lo, &hi);
+    for (size_t k = 0; k < moved.size(); ++k) {
+      bbox(moved[k], &mlo[k], &mhi[k]);
+      lo = k == 0 ? mlo[k] : Vec3(std::min(lo.x, mlo[k].x), std::min(lo.y, mlo[k].y), std::min(lo.z, mlo[k].z));
+      hi = k == 0 ? mhi[k] : Vec3(std::max(hi.x, mhi[k].x), std::max(hi.y, mhi[k].y), std::max(hi.z, mhi[k].z));
+    }
     int r0[3], r1[3];
     cell_range(lo, hi, r0, r1);
     ++query_;
@@ -482,15 +522,20 @@ class Decimator {
             if (stamp_[g] == query_ || !face_alive_[g]) continue;
             stamp_[g] = query_;
             const auto& t = faces_[g];
-            bool shares = has_vertex(t, a) || has_vertex(t, b);
-            for (int c = 0; c < 3 && !shares; ++c) shares = has_vertex(t, ids[c]);
-            if (shares) continue;
+            if (has_vertex(t, a) || has_vertex(t, b)) continue;  // part of the star
             const auto Q = face_points(g);
             Vec3 qlo, qhi;
             bbox(Q, &qlo, &qhi);
             if (qlo.x > hi.x || qlo.y > hi.y || qlo.z > hi.z || qhi.x < lo.x || qhi.y < lo.y || qhi.z < lo.z)
               continue;
-            if (cage_detail::triangles_intersect(P[0], P[1], P[2], Q[0], Q[1], Q[2])) return true;
+            for (size_t k = 0; k < moved.size(); ++k) {
+              if (qlo.x > mhi[k].x || qlo.y > mhi[k].y || qlo.z > mhi[k].z || qhi.x < mlo[k].x ||
+                  qhi.y < mlo[k].y || qhi.z < mlo[k].z)
+                continue;
+              if (has_vertex(t, ids[k][0]) || has_vertex(t, ids[k][1]) || has_vertex(t, ids[k][2])) continue;
+              const auto& P = moved[k];
+              if (cage_detail::triangles_intersect(P[0], P[1], P[2], Q[0], Q[1], Q[2])) return true;
+            }
           }
         }
     return false;
@@ -506,8 +551,7 @@ class Decimator {
   std::vector<std::vector<int>> vf_;
   std::vector<Quadric> quadric_;
   std::vector<uint8_t> vert_alive_;
-  std::vector<unsigned> version_;
-  std::priority_queue<HeapEntry> heap_;
+  EdgeHeap heap_;
   int alive_vertices_ = 0, alive_faces_ = 0, grid_faces_ = 0;
   // grid over faces
   Vec3 grid_lo_;
@@ -542,10 +586,6 @@ HullDecimation hull_decimation(const Eigen::MatrixXd& V, const Eigen::MatrixXi& 
   if (!out.status.ok()) return out;
   d.output(&out.V, &out.F);
   progress.update("cage: simplify", 1.0);
-#ifdef MM_HULL_DEBUG
-  for (int i = 0; i < 9; ++i) std::fprintf(stderr, "%d ", hull_detail::g_dbg[i]);
-  std::fprintf(stderr, "\n");
-#endif
   return out;
 }
 

@@ -1,8 +1,11 @@
 #include "edit/laplacian_editor.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <string>
+#include <cstdio>
+#include <cstdlib>
 
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
@@ -97,7 +100,8 @@ Status check_region_manifold(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   for (size_t s = 0; s < edges.size();) {
     size_t e = s;
     while (e < edges.size() && edges[e].a == edges[s].a && edges[e].b == edges[s].b) ++e;
-    if (e - s > 2 && (is_unknown[edges[s].a] || is_unknown[edges[s].b])) {
+    // Counts within the subset never exceed the true counts, so > 2 is always a real defect.
+    if (e - s > 2) {
       if (bad++ == 0) first_a = edges[s].a, first_b = edges[s].b;
     }
     s = e;
@@ -152,6 +156,14 @@ Status check_region_manifold(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
 
 Sparse top_left(const Sparse& A, int n) { return A.topLeftCorner(n, n); }
 
+// Milliseconds since `t0`; resets t0 to now.
+double lap_ms(std::chrono::steady_clock::time_point* t0) {
+  const auto now = std::chrono::steady_clock::now();
+  const double ms = std::chrono::duration<double, std::milli>(now - *t0).count();
+  *t0 = now;
+  return ms;
+}
+
 }  // namespace edit_detail
 
 using namespace edit_detail;
@@ -177,7 +189,7 @@ struct LaplacianEditor::Impl {
   std::vector<int> l2g;
   std::vector<int> group;   // per local vertex: handle index, -1 fixed/outside, -2 plain free unknown
   std::vector<double> soft; // per unknown: soft weight ws/h² (0 when not soft-constrained)
-  std::vector<int> rows;    // unknowns (local) that carry a Laplacian row (hard: free ones; soft: all)
+  std::vector<char> has_row;  // per unknown: carries a Laplacian row (not soft-constrained)
 
   ImplicitGradients grads;      // centers in global numbering
   std::vector<int> center_of;   // per local unknown: index into grads.centers (-1 if none)
@@ -203,6 +215,7 @@ struct LaplacianEditor::Impl {
   Eigen::MatrixXd X1;        // nL by 3: stage-1 positions (displaced frame)
   Eigen::MatrixXd known;     // nK by 3: known positions in the original frame
   Eigen::MatrixXd soft_u;    // nU by 3: soft targets in the original frame (rows with soft > 0)
+  std::vector<Eigen::Matrix3d> linear;  // per handle: linear part used by the last drag
 
   bool ready = false;
 
@@ -245,7 +258,9 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     return Status::error(StatusCode::InvalidArgument,
                          "edit options out of range (weights must be finite and ≥ 0, coherence_weight > 0, "
                          "condition_threshold > 1, displacement_scale > 0)");
+  auto t_check = std::chrono::steady_clock::now();
   if (Status s = check_mesh(Vin, F); !s.ok()) return s;
+  if (std::getenv("MM_EDIT_DEBUG")) std::fprintf(stderr, "  [edit] check_mesh %.1f ms\n", lap_ms(&t_check));
   V = Vin;
   const int n = static_cast<int>(V.rows());
   num_handles = static_cast<int>(region.handles.size());
@@ -299,12 +314,19 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     return Status::error(StatusCode::InvalidArgument,
                          "the region of interest has no free vertex (every ROI vertex is a handle or fixed)");
 
+  auto dbg = std::chrono::steady_clock::now();
+  const bool dbg_on = std::getenv("MM_EDIT_DEBUG") != nullptr;
+  auto dbg_lap = [&](const char* what) {
+    if (dbg_on) std::fprintf(stderr, "  [edit] %s %.1f ms\n", what, lap_ms(&dbg));
+  };
   const auto adj = vertex_adjacency(F, n);
+  dbg_lap("adjacency");
   // Faces around the unknowns: complete 1-rings for their Laplacian rows.
   std::vector<int> faces;
   for (int f = 0; f < F.rows(); ++f)
     if (unknown[F(f, 0)] || unknown[F(f, 1)] || unknown[F(f, 2)]) faces.push_back(f);
   if (Status s = check_region_manifold(V, F, faces, unknown); !s.ok()) return s;
+  dbg_lap("manifold");
   for (int v : U)
     if (adj[v].empty())
       return Status::error(StatusCode::InvalidMesh, "vertex " + std::to_string(v) + " of the region of interest is isolated");
@@ -338,7 +360,9 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
                                  " are not connected to any handle or fixed vertex; add a constraint there or shrink the ROI");
     }
   }
+  dbg_lap("components");
   if (!progress.update("edit: stencils", 0.0)) return cancelled_status("edit: stencils");
+  auto clock = std::chrono::steady_clock::now();
 
   // ---- the scale h: mean edge length around the unknowns
   double h = 0;
@@ -369,6 +393,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     Vd = V;
   }
   if (!progress.update("edit: stencils", 1.0)) return cancelled_status("edit: stencils");
+  stats.stencil_ms = lap_ms(&clock);
 
   // ---- local numbering
   std::vector<int> g2l(n, -1);
@@ -376,6 +401,8 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
   std::vector<char> referenced(n, 0);
   for (int f : faces)
     for (int c = 0; c < 3; ++c) referenced[F(f, c)] = 1;
+  for (int v = 0; v < n; ++v)
+    if (gid[v] >= 0) referenced[v] = 1;  // every handle vertex moves, even those no system row touches
   std::vector<int> center_index(n, -1);
   if (implicit) {
     for (size_t c = 0; c < grads.centers.size(); ++c) center_index[grads.centers[c]] = static_cast<int>(c);
@@ -412,8 +439,11 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
   const double ws = opt.soft_constraint_weight / (h * h);
   for (int l = 0; l < nU; ++l)
     if (group[l] != -2) soft[l] = ws;
-  rows.clear();
-  for (int l = 0; l < nU; ++l) rows.push_back(l);  // every unknown carries a Laplacian row
+  // Laplacian rows (E_L, Eq. 5, and Eq. 9/10) belong to unconstrained vertices only, as in the paper;
+  // soft-constrained unknowns get their soft row instead, so that soft → hard as the weight grows.
+  has_row.assign(nU, 1);
+  for (int l = 0; l < nU; ++l)
+    if (group[l] != -2) has_row[l] = 0;
   stats.free_vertices = nU;
   stats.known_vertices = nL - nU;
   if (implicit) {
@@ -431,6 +461,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
       if (disp[l2g[l]]) displaced_unknowns.push_back(l);
   }
 
+  dbg_lap("numbering");
   // ---- Laplacian operators on the face set. Stage 1 uses the displaced rest mesh, stage 2 the
   // undisplaced one. D_i = −(2/A_i)·W_i (cotangent, paper Sec. 2) or D_i = −L_i/deg_i (uniform).
   Eigen::MatrixXi Fsub(faces.size(), 3);
@@ -467,10 +498,13 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     } else {
       // Rows scaled to the paper's D (dimensionless with h): the least-squares weights matter here.
       row_scale2 = (cot ? h : 1.0 / h) * ds2;
+      for (int l = 0; l < nU; ++l)
+        if (!has_row[l]) row_scale2[l] = 0;
       const Sparse Ds = row_scale2.asDiagonal() * W2;
       D2_UU = Ds.leftCols(nU);
       D2_UK = Ds.rightCols(nL - nU);
     }
+    dbg_lap("poisson assembly");
     if (!progress.update("edit: poisson factor", 0.0)) return cancelled_status("edit: poisson factor");
     Sparse N2;
     if (!soft_mode) {
@@ -482,6 +516,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     }
     if (Status s = solver2.factor(N2); !s.ok())
       return Status::error(s.code, "Poisson system (Eq. 9/10): " + s.message);
+    stats.poisson_ms = lap_ms(&clock);
   }
   if (!progress.update("edit: assembling", 0.0)) return cancelled_status("edit: assembling");
 
@@ -498,6 +533,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     const Eigen::MatrixXd W1X = W1 * Xd;
     std::vector<Trip> t;
     for (int l = 0; l < nU; ++l) {
+      if (!has_row[l]) continue;
       const Eigen::Vector3d delta = ds1[l] * W1X.row(l).transpose();
       const int c = center_of[l];
       for (int e = grads.offsets[c]; e < grads.offsets[c + 1]; ++e)
@@ -506,10 +542,14 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     Sparse E(nU, nL);
     E.setFromTriplets(t.begin(), t.end());
     {
-      const Eigen::VectorXd s = lscale * ds1;
+      Eigen::VectorXd s = lscale * ds1;
+      for (int l = 0; l < nU; ++l)
+        if (!has_row[l]) s[l] = 0;
       E += s.asDiagonal() * W1;
     }
+    dbg_lap("E_L rows");
     Sparse N = Sparse(E.transpose()) * E;
+    dbg_lap("EtE");
     if (!progress.update("edit: assembling", 0.3)) return cancelled_status("edit: assembling");
 
     // E_R (Eq. 6) over SF = pairs within r rings, at least one of them active:
@@ -560,12 +600,14 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
       for (int e = grads.offsets[c]; e < grads.offsets[c + 1]; ++e)
         for (int k = 0; k < 3; ++k) kt.emplace_back(stencil_local[e], 3 * p + k, grads.weights(e, k));
     }
+    dbg_lap("pairs");
     Sparse Khat(nL, 3 * nP);
     Khat.setFromTriplets(kt.begin(), kt.end());
     {
       const Sparse KG = Khat * Ghat;
       N += Sparse(KG * Sparse(Khat.transpose()));
     }
+    dbg_lap("KGK");
     if (!progress.update("edit: assembling", 0.8)) return cancelled_status("edit: assembling");
 
     // Optional transformation constraints M_k = A_h at handle vertices (Eq. 7).
@@ -591,14 +633,18 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     for (int l = 0; l < nU; ++l)
       if (soft[l] > 0) N.coeffRef(l, l) += soft[l];
 
+    dbg_lap("gradc+soft");
     Q1 = N.block(0, nU, nU, nL - nU);
     const Sparse NUU = top_left(N, nU);
     stats.system_nonzeros = static_cast<long>(Sparse(NUU.triangularView<Eigen::Lower>()).nonZeros());
+    dbg_lap("split");
+    stats.assembly_ms = lap_ms(&clock);
     if (!progress.update("edit: factor", 0.0)) return cancelled_status("edit: factor");
     if (Status s = solver1.factor(NUU); !s.ok())
       return Status::error(s.code, "implicit editing system (Eq. 7): " + s.message +
                                        ". The handles may not determine a rotation: constrain at least 3 "
                                        "non-collinear vertices");
+    stats.factor_ms = lap_ms(&clock);
     if (!progress.update("edit: factor", 1.0)) return cancelled_status("edit: factor");
 
     // ---- handle response basis: Φ_0 for the fixed part, Φ_h (4 columns) per handle.
@@ -636,6 +682,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
       Phi.resize(num_handles);
       for (int hh = 0; hh < num_handles; ++hh) Phi[hh] = X.block(0, 3 + 4 * hh, nU, 4);
       have_basis = true;
+      stats.basis_ms = lap_ms(&clock);
     }
   }
   if (!progress.update("edit: done", 1.0)) return cancelled_status("edit: done");
@@ -652,8 +699,9 @@ Eigen::Matrix3d LaplacianEditor::Impl::gradient_local(int l) const {
 }
 
 Status LaplacianEditor::Impl::solve_stage1(const Eigen::MatrixXd& known_d, const Eigen::MatrixXd& soft_d,
-                                           const std::vector<Eigen::Matrix3d>& linear,
+                                           const std::vector<Eigen::Matrix3d>& linear_parts,
                                            const std::vector<Eigen::Vector3d>* translation) {
+  linear = linear_parts;
   X1.resize(nL, 3);
   X1.bottomRows(nL - nU) = known_d;
   Eigen::MatrixXd xU;
@@ -662,7 +710,7 @@ Status LaplacianEditor::Impl::solve_stage1(const Eigen::MatrixXd& known_d, const
     xU = Phi0;
     for (int h = 0; h < num_handles; ++h) {
       Eigen::Matrix<double, 4, 3> T;
-      T.topRows(3) = linear[h].transpose();
+      T.topRows(3) = linear_parts[h].transpose();
       T.row(3) = (*translation)[h].transpose();
       xU.noalias() += Phi[h] * T;
     }
@@ -672,7 +720,7 @@ Status LaplacianEditor::Impl::solve_stage1(const Eigen::MatrixXd& known_d, const
     Eigen::MatrixXd rhs = -(Q1 * known_d);
     for (int l = 0; l < nU; ++l)
       if (soft[l] > 0) rhs.row(l) += soft[l] * soft_d.row(l);
-    for (int h = 0; h < num_handles; ++h) rhs.noalias() += G1.block(0, 3 * h, nU, 3) * linear[h].transpose();
+    for (int h = 0; h < num_handles; ++h) rhs.noalias() += G1.block(0, 3 * h, nU, 3) * linear_parts[h].transpose();
     if (Status s = solver1.solve(rhs, &xU); !s.ok()) return s;
   }
   X1.topRows(nU) = xU;
@@ -684,10 +732,12 @@ EditResult LaplacianEditor::Impl::output_stage1() {
   out.V = V;
   for (int l = 0; l < nU; ++l) out.V.row(l2g[l]) = X1.row(l);
   for (int k = 0; k < nL - nU; ++k) out.V.row(l2g[nU + k]) = known.row(k);
-  // Pull-back of displaced free vertices (Sec. 3.3): ṽ = M (v − v') + ṽ'.
+  // Pull-back of displaced free vertices (Sec. 3.3): ṽ = M (v − v') + ṽ'. A soft-constrained one
+  // uses its handle's linear part instead (its target was set as A v' + t), so that soft
+  // constraints tend to hard ones as their weight grows.
   for (int l : displaced_unknowns) {
-    const int v = l2g[l];
-    const Eigen::Matrix3d M = gradient_local(l);
+    const int v = l2g[l], g = group[l];
+    const Eigen::Matrix3d M = g == -2 ? gradient_local(l) : g == -1 ? Eigen::Matrix3d::Identity() : linear[g];
     out.V.row(v) = (X1.row(l).transpose() + M * (V.row(v) - Vd.row(v)).transpose()).transpose();
   }
   if (!out.V.allFinite())

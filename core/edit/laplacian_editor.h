@@ -120,6 +120,12 @@ struct EditStats {
   long factor_nonzeros = 0;      // nnz of its Cholesky factor
   double max_condition = 0;      // max cond(V_i V_iᵀ) after the degenerate handling
   double mean_edge_length = 0;   // h, the scale of the edited region (mesh units)
+  // Wall time of the precompute stages in ms (for bench/ and the CLI's --verbose; not deterministic).
+  double stencil_ms = 0;         // Eq. 2–4 stencils and Sec. 3.3 degenerate handling
+  double assembly_ms = 0;        // AᵀA of Eq. 7 (E_L + E_R)
+  double factor_ms = 0;          // Cholesky of AᵀA
+  double basis_ms = 0;           // handle response basis (4 back-substitutions per handle)
+  double poisson_ms = 0;         // assembly + factor of the Eq. 9/10 system
 };
 
 struct EditResult {

@@ -78,6 +78,23 @@ SelectionResult select_vertices(const Eigen::MatrixXd& V, const Eigen::MatrixXi&
       if ((p.array() >= b.min.array()).all() && (p.array() <= b.max.array()).all()) mark[v] = 1;
     }
   }
+  if (!sel.slabs.empty() && n > 0) {
+    const Eigen::RowVector3d lo = V.colwise().minCoeff(), hi = V.colwise().maxCoeff();
+    for (const auto& s : sel.slabs) {
+      if (s.axis < -1 || s.axis > 2 || !std::isfinite(s.from) || !std::isfinite(s.to) || s.from > s.to) {
+        out.status = Status::error(StatusCode::InvalidArgument,
+                                   "slab selector needs axis -1 (longest), 0, 1 or 2 and from ≤ to");
+        return out;
+      }
+      int axis = s.axis;
+      if (axis < 0) (hi - lo).maxCoeff(&axis);
+      const double extent = hi[axis] - lo[axis];
+      for (int v = 0; v < n; ++v) {
+        const double t = extent > 0 ? (V(v, axis) - lo[axis]) / extent : 0.0;
+        if (t >= s.from && t <= s.to) mark[v] = 1;
+      }
+    }
+  }
   if (!sel.rings.empty() || !sel.disks.empty()) {
     const auto adjacency = vertex_adjacency(F, n);
     for (const auto& r : sel.rings) {

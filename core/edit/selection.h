@@ -27,6 +27,11 @@ struct VertexSelection {
     int vertex = 0;  // seed vertex index
     int k = 1;       // ≥ 0 edges from the seed (0 = the seed only)
   };
+  struct Slab {
+    int axis = -1;      // 0, 1, 2 = x, y, z; -1 = the longest axis of the bounding box
+    double from = 0;    // relative position along the axis: 0 = bbox min, 1 = bbox max
+    double to = 1;      // vertices with from ≤ t ≤ to are selected (from ≤ to)
+  };
   struct GeodesicDisk {
     int vertex = 0;     // seed vertex index
     double radius = 0;  // ≥ 0; shortest edge-path length from the seed (an upper bound of the
@@ -38,9 +43,10 @@ struct VertexSelection {
   std::vector<Box> boxes;
   std::vector<Ring> rings;
   std::vector<GeodesicDisk> disks;
+  std::vector<Slab> slabs;
 
   bool empty() const {
-    return indices.empty() && spheres.empty() && boxes.empty() && rings.empty() && disks.empty();
+    return indices.empty() && spheres.empty() && boxes.empty() && rings.empty() && disks.empty() && slabs.empty();
   }
 };
 

@@ -11,8 +11,21 @@
 // The raw layout (V_raw/F_raw) concatenates primitives; the geometry mesh every algorithm
 // uses is the welded one (glTF splits vertices at UV/normal seams; see mesh/weld.h).
 //
+// Skinned primitives get their node's world transform too (positions are the bind pose as
+// placed by the node); PrimitiveRef::skinned marks them.
+//
 // Security: external URIs of a .gltf are resolved only inside the file's own folder; absolute
-// paths, "..", and URI schemes other than data: are refused with IoError.
+// paths, "..", and URI schemes other than data: are refused with IoError before the resolver
+// is asked.
+//
+// Status codes: IoError (file missing/unreadable/unwritable, refused or missing external URI),
+// ParseError (malformed contents: empty file, truncated GLB, bad JSON, indices out of range,
+// counts larger than the data, OBJ index 0), Unsupported (unknown extension, non-triangle glTF
+// primitives, binary OFF, compressed glTF geometry), InvalidArgument / NumericalError (save:
+// wrong shape or non-finite positions). NaN coordinates load fine; mesh/validate.h reports them.
+//
+// glTF documents: code inside core/io (and the retarget export) reaches the tinygltf::Model
+// through io/gltf_document.h.
 #pragma once
 
 #include <cstdint>
@@ -98,7 +111,12 @@ struct SaveOptions {
 // document is kept (glTF: accessors, materials, textures, nodes, skins, animations; OBJ: UVs,
 // normals, groups, materials; PLY: extra properties). Converting between formats keeps what
 // the target format can hold. glTF output for a changed primitive gets new POSITION (and
-// NORMAL) accessors in local space (inverse node transform) with correct min/max.
+// NORMAL) accessors in local space (inverse node transform) with correct min/max; the old
+// accessors stay, so no index in the document changes. A mesh instanced by several nodes is
+// copied for an instance whose new positions differ from the first instance's (gltf_save.h).
+// A raw vertex whose welded position is unchanged keeps its exact original coordinates.
+// .gltf saved by path writes its buffers to "<name>.bin" next to it and copies external images
+// (same URI); saved to memory, buffers become data URIs. GLB output embeds everything.
 Status save_asset(const Asset& asset, const Eigen::MatrixXd& V, const std::string& path,
                   const SaveOptions& opt = {});
 Status save_asset_to_memory(const Asset& asset, const Eigen::MatrixXd& V, Format format,

@@ -16,3 +16,4 @@ list(APPEND MM_IO_SOURCES
   core/io/tinygltf_impl.cpp)
 list(APPEND MM_TEST_SOURCES tests/io_test.cpp tests/io_gltf_test.cpp)
 list(APPEND MM_IO_SOURCES core/io/info_report.cpp)  # owned by the lead: the `info` report shared by CLI and wasm
+include(core/io/animation_sources.cmake OPTIONAL)  # retarget: glTF skins/animations (issue 5)

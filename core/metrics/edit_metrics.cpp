@@ -125,8 +125,9 @@ EdgeDistortion edge_length_distortion(const Eigen::MatrixXd& V0, const Eigen::Ma
   return d;
 }
 
-Eigen::VectorXd laplacian_normal_angle(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
-  const Eigen::MatrixXd L = cotan_stiffness(V, F) * V;  // −½·(mean-curvature normal)·area, up to sign
+Eigen::VectorXd laplacian_normal_angle(const Eigen::MatrixXd& V0, const Eigen::MatrixXd& V1, const Eigen::MatrixXi& F) {
+  const Eigen::MatrixXd L = cotan_stiffness(V0, F) * V1;  // −(Voronoi area/2)·D(ṽ); only its line matters
+  const Eigen::MatrixXd& V = V1;
   const Eigen::MatrixXd N = vertex_normals(V, F);
   Eigen::VectorXd a = Eigen::VectorXd::Zero(V.rows());
   for (int i = 0; i < V.rows(); ++i) {
@@ -141,7 +142,7 @@ Eigen::VectorXd laplacian_normal_angle(const Eigen::MatrixXd& V, const Eigen::Ma
 DetailPreservation detail_preservation(const Eigen::MatrixXd& V0, const Eigen::MatrixXd& V1, const Eigen::MatrixXi& F,
                                        const std::vector<int>& vertices) {
   const Eigen::VectorXd w = (cotan_stiffness(V0, F) * V0).rowwise().norm();
-  const Eigen::VectorXd a0 = laplacian_normal_angle(V0, F), a1 = laplacian_normal_angle(V1, F);
+  const Eigen::VectorXd a0 = laplacian_normal_angle(V0, V0, F), a1 = laplacian_normal_angle(V0, V1, F);
   DetailPreservation out;
   double sw = 0;
   auto add = [&](int i) {

@@ -34,13 +34,16 @@ struct EdgeDistortion {
 };
 EdgeDistortion edge_length_distortion(const Eigen::MatrixXd& V0, const Eigen::MatrixXd& V1, const Eigen::MatrixXi& F);
 
-// Per-vertex angle in degrees (0..90) between the line of the cotangent Laplacian coordinate of V
-// (mean-curvature normal) and the line of the vertex normal of V. #V values.
-Eigen::VectorXd laplacian_normal_angle(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+// Per-vertex angle in degrees (0..90) between the line of the deformed Laplacian coordinate
+// D(ṽ_i) = Σ_j w_ij (ṽ_j − ṽ_i) — cotangent weights w_ij of the REST mesh V0, as in paper 001
+// Eq. 1, applied to the deformed positions V1 — and the line of the vertex normal of V1. Rest
+// weights matter: the deformed mesh's own cotangent Laplacian is parallel to its normal for any
+// smooth surface and would not show whether details were rotated. #V values.
+Eigen::VectorXd laplacian_normal_angle(const Eigen::MatrixXd& V0, const Eigen::MatrixXd& V1, const Eigen::MatrixXi& F);
 
 struct DetailPreservation {
-  double mean_angle_deg = 0;       // |δ0|-weighted mean of laplacian_normal_angle(V1) over `vertices`
-  double rest_mean_angle_deg = 0;  // the same measure on V0 (the mesh's own discretisation floor)
+  double mean_angle_deg = 0;       // |δ0|-weighted mean of laplacian_normal_angle(V0, V1) over `vertices`
+  double rest_mean_angle_deg = 0;  // the same measure at rest, (V0, V0): the mesh's discretisation floor
 };
 // Detail preservation over a vertex subset (all vertices when empty). Weights are the rest
 // Laplacian-coordinate magnitudes |(W V0)_i|, so that flat areas (whose LC direction is noise)

@@ -67,7 +67,22 @@ Status MfsHarmonicMap::build(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   if (!sr.status.ok()) return sr.status;
   Q_ = std::move(sr.Q);
   if (!progress.update("collocation", 0.3)) return cancelled_status("collocation");
-  const SurfaceSamples all = surface_samples(V, F, 4 * opt.num_collocation);
+  SurfaceSamples all = surface_samples(V, F, 2 * opt.num_collocation);
+  {
+    // Multi-part characters overlap (an arm primitive reaches into the torso): surface buried
+    // inside another part is not a boundary of the shape, and fitting it would force the map to
+    // follow both parts at once. Such samples (whose outward nudge is inside the shape on both
+    // sides) are left out of the fit.
+    const TriangleBvh bvh(V, F);
+    const double eps = 2e-3 * bounding_box_diagonal(V);
+    std::vector<int> keep;
+    for (int s = 0; s < all.size(); ++s) {
+      const Eigen::Vector3d p = all.P.row(s).transpose(), n = all.N.row(s).transpose();
+      if (bvh.inside(p + eps * n) && bvh.inside(p - eps * n)) continue;
+      keep.push_back(s);
+    }
+    if (keep.size() >= 4 * static_cast<size_t>(Q_.rows())) all = select_samples(all, keep);
+  }
   colloc_ = select_samples(all, farthest_point_sampling(all.P, opt.num_collocation, 0));
   F_ = F;
   if (colloc_.size() < Q_.rows())

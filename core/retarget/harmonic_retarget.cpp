@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Geometry>
 #include <Eigen/SVD>
 
 #include "mesh/mesh.h"
@@ -245,7 +246,11 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
     const SurfaceSamples& C = tgt_map_.collocation();
     const int nh = std::min(opt.num_smooth_points, C.size());
     // Collocation points are already in FPS order, so a prefix is a well-spread subset.
-    synth_.add_term({"smooth", mfs_hessian(C.P.topRows(nh), U), opt.w_smooth / std::max(1, nh), true});
+    // The Hessian has units 1/length: scaled by the offset distance (the shortest length the MFS
+    // basis resolves) E_smooth becomes dimensionless like E_affine, so λ_smooth does not depend
+    // on how far the singularities sit.
+    const double ell = opt.map.singularities.offset;
+    synth_.add_term({"smooth", ell * mfs_hessian(C.P.topRows(nh), U), opt.w_smooth / std::max(1, nh), true});
   }
   s = synth_.factor(opt.ridge);
   if (!s.ok()) return s;
@@ -276,14 +281,20 @@ RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) cons
   const Eigen::MatrixXd p_anchor =
       Jt_rest_.row(anchor_) + scale_ * (Js_now.row(anchor_) - Js_rest_.row(anchor_));
 
-  // E_bone, first linearisation: the rest bone mapped by the mean Jacobian of its two ends.
+  // E_bone, first linearisation: each target bone turns like its source bone, by the minimal
+  // rotation taking the source rest bone to the fitted source bone f_s(c) − f_s(p). (The mean
+  // Jacobian of the two ends would blend in the neighbouring bones' rotations at the joints.)
   const int nb = static_cast<int>(bones_.size());
   Eigen::MatrixXd dirs(nb, 3);
   for (int b = 0; b < nb; ++b) {
     const auto [c, p] = bones_[b];
-    const Eigen::Matrix3d Jc = JsT.middleRows(3 * c, 3).transpose(), Jp = JsT.middleRows(3 * p, 3).transpose();
-    const Eigen::Vector3d d = 0.5 * (Jc + Jp) * (Jt_rest_.row(c) - Jt_rest_.row(p)).transpose();
-    dirs.row(b) = d.norm() > 0 ? (d / d.norm()).transpose() : Eigen::RowVector3d(Jt_rest_.row(c) - Jt_rest_.row(p)).normalized();
+    const Eigen::Vector3d s0 = (Js_rest_.row(c) - Js_rest_.row(p)).transpose();
+    const Eigen::Vector3d s1 = (Js_now.row(c) - Js_now.row(p)).transpose();
+    const Eigen::Vector3d t0 = (Jt_rest_.row(c) - Jt_rest_.row(p)).transpose().normalized();
+    if (s0.norm() > 1e-12 && s1.norm() > 1e-12)
+      dirs.row(b) = (Eigen::Quaterniond::FromTwoVectors(s0, s1) * t0).transpose();
+    else
+      dirs.row(b) = t0.transpose();
   }
   std::vector<const Eigen::MatrixXd*> rhs(synth_.num_terms(), nullptr);
   rhs[term_affine_] = &JsT;

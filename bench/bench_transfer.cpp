@@ -1,0 +1,77 @@
+// Pose-transfer stages (issue 4) for the largest pair in data/: TOSCA horse0 (19,248 v) as the
+// reference, Sumner camel_ref (21,887 v) as the source, with data/landmarks/horse0-camel_ref.json.
+// Peer: paper 000 Table 1, Fig. 1 pair (19,248 / 10,889 v, cage 452; Core i7-3520M):
+// bases + MVC 122.1 s, optimisation 31.5 s (10 iterations). --quick uses cat-01 → lion.
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "bench.h"
+#include "io/asset.h"
+#include "transfer/pose_transfer.h"
+
+namespace mm::bench {
+namespace {
+
+std::vector<LandmarkPair> bench_transfer_pairs(const std::string& path) {
+  std::vector<LandmarkPair> out;
+  std::ifstream in(path);
+  nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  if (j.is_discarded()) return out;
+  for (const auto& p : j["pairs"]) out.push_back({p[0].get<int>(), p[1].get<int>()});
+  return out;
+}
+
+void transfer_suite(Context& ctx) {
+  const std::string ref_rel = ctx.quick ? "pose/cat-01.ply" : "pose/horse0.ply";
+  const std::string src_rel = ctx.quick ? "pose/lion-reference.ply" : "pose/camel_ref.ply";
+  const std::string lm_rel = ctx.quick ? "landmarks/cat-lion.json" : "landmarks/horse0-camel_ref.json";
+  const std::string ref_path = ctx.find_data(ref_rel), src_path = ctx.find_data(src_rel), lm_path = ctx.find_data(lm_rel);
+  if (ref_path.empty() || src_path.empty() || lm_path.empty()) {
+    std::fprintf(stderr, "  transfer: data missing, skipped\n");
+    return;
+  }
+  const io::LoadResult ref = io::load_asset(ref_path), src = io::load_asset(src_path);
+  if (!ref.status.ok() || !src.status.ok()) return;
+  const Mesh R = ref.asset.mesh(), S = src.asset.mesh();
+  const auto pairs = bench_transfer_pairs(lm_path);
+  PoseTransferResult best;
+  const int repeats = ctx.quick ? 1 : 3;
+  std::vector<PoseTransferResult> runs;
+  for (int i = 0; i < repeats; ++i) runs.push_back(pose_transfer(R, S, pairs));
+  if (!runs[0].status.ok()) {
+    std::fprintf(stderr, "  transfer: %s\n", runs[0].status.message.c_str());
+    return;
+  }
+  auto median = [&](double PoseTransferTimings::*f) {
+    std::vector<double> v;
+    for (const auto& r : runs) v.push_back(r.ms.*f);
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  const PoseTransferResult& r = runs[0];
+  const std::string mesh = S.num_vertices() > 20000 ? "horse0->camel_ref" : "cat-01->lion";
+  const int nv = S.num_vertices();
+  const bool big = !ctx.quick;
+  ctx.add({"transfer", mesh, nv, "eigenbases (2 meshes, k'=20)", median(&PoseTransferTimings::eigenbases), "", ""});
+  ctx.add({"transfer", mesh, nv, "coupled bases", median(&PoseTransferTimings::coupling), "",
+           std::to_string(r.coupling_iterations) + " steps, Γ dominance " + std::to_string(r.gamma_dominance).substr(0, 5)});
+  ctx.add({"transfer", mesh, nv, "cage", median(&PoseTransferTimings::cage), "",
+           std::to_string(r.cage_rest.rows()) + " cage vertices"});
+  ctx.add({"transfer", mesh, nv, "mean-value coordinates", median(&PoseTransferTimings::mvc), "", ""});
+  ctx.add({"transfer", mesh, nv, "bases + cage + MVC",
+           median(&PoseTransferTimings::eigenbases) + median(&PoseTransferTimings::coupling) +
+               median(&PoseTransferTimings::cage) + median(&PoseTransferTimings::mvc),
+           big ? "paper 000: 122.1 s (bases + MVC)" : "", ""});
+  ctx.add({"transfer", mesh, nv, "optimisation", median(&PoseTransferTimings::optimisation),
+           big ? "paper 000: 31.5 s (10 it)" : "", std::to_string(r.iterations) + " iterations"});
+  ctx.add({"transfer", mesh, nv, "whole transfer", median(&PoseTransferTimings::total),
+           big ? "paper 000: 153.6 s; aim <= 3 s" : "", ""});
+}
+
+}  // namespace
+}  // namespace mm::bench
+
+MM_BENCH(transfer, mm::bench::transfer_suite);

@@ -1,0 +1,86 @@
+// RetargetSession: the whole retargeting job on loaded files — source character and clip, target
+// (glTF with or without a skin, or a plain mesh with joints from JSON), harmonic or LBS method,
+// frames, and the GLB writer — shared by the CLI, the wasm binding and the bench so that they
+// stay thin. Precompute once (prepare), then frames in any order or batch.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/progress.h"
+#include "common/status.h"
+#include "io/asset.h"
+#include "io/gltf_animation.h"
+#include "retarget/harmonic_retarget.h"
+#include "retarget/lbs_baseline.h"
+
+namespace mm::io {
+
+enum class RetargetMethod {
+  Harmonic,  // paper 002 (retarget/harmonic_retarget.h)
+  Lbs,       // baseline: source skin weights on the target (retarget/lbs_baseline.h)
+};
+
+struct RetargetJobOptions {
+  std::string clip;                 // source clip name; "" = the first clip
+  double fps = 30;                  // frame rate of the sampled clip
+  int first_frame = 0;              // frame range [first_frame, last_frame) of the sampled clip
+  int last_frame = -1;              // -1 = to the end
+  RetargetMethod method = RetargetMethod::Harmonic;
+  HarmonicRetargetOptions harmonic; // method options (paper defaults, see harmonic_retarget.h)
+  SurfaceSelection surface = SurfaceSelection::Auto;  // which glTF primitives form each character
+};
+
+class RetargetSession {
+ public:
+  // source: a skinned, animated glTF. target: glTF or mesh. target_joints_json: {"name": [x,y,z]}
+  // (required when the target has no skin; overrides its skin otherwise). joint_map_json:
+  // {"source joint": "target joint"} or "". Progress stages of the harmonic precompute.
+  Status prepare(const Asset& source, const Asset& target, const std::string& target_joints_json,
+                 const std::string& joint_map_json, const RetargetJobOptions& opt, const Progress& progress = {});
+
+  int num_frames() const { return static_cast<int>(times_.size()); }
+  const std::vector<double>& times() const { return times_; }  // seconds, clip time of each frame
+  const std::string& clip_name() const { return clip_name_; }
+
+  // Target surface (layout of target_rest) at frame k.
+  Status frame(int k, Eigen::MatrixXd* V) const;
+  // Frames [first, first + count), with progress per frame ("frames") and cancel.
+  Status frames(int first, int count, std::vector<Eigen::MatrixXd>* out, const Progress& progress = {}) const;
+  // The source surface at frame k (for metrics: self-retargeting compares with it).
+  Eigen::MatrixXd source_frame(int k) const;
+  // Target joints at frame k (harmonic only: f_t(J_t) of the used joints), and bone data.
+  const HarmonicRetargeter& harmonic() const { return harmonic_; }
+
+  const Eigen::MatrixXd& target_rest() const { return target_V_; }
+  const Eigen::MatrixXi& target_faces() const { return target_F_; }
+  bool target_is_gltf() const { return target_is_gltf_; }
+  const AnimatedCharacter& source_character() const { return source_; }
+  const AnimatedCharacter* target_character() const { return target_is_gltf_ ? &target_ : nullptr; }
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+  // The animated target as GLB bytes (frames as from frames(), times relative to the first).
+  Status write_glb(const std::vector<Eigen::MatrixXd>& frames, const std::vector<double>& times,
+                   std::vector<uint8_t>* bytes) const;
+
+ private:
+  RetargetJobOptions opt_;
+  Asset target_asset_;
+  AnimatedCharacter source_, target_;
+  bool target_is_gltf_ = false;
+  int clip_ = -1;
+  std::string clip_name_;
+  std::vector<double> times_;
+  Eigen::MatrixXd target_V_;
+  Eigen::MatrixXi target_F_;
+  std::vector<std::string> warnings_;
+  HarmonicRetargeter harmonic_;
+  // LBS baseline state.
+  Similarity align_;
+  SkinWeights lbs_weights_;
+};
+
+}  // namespace mm::io

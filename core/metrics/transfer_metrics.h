@@ -1,0 +1,34 @@
+// Quality measures of a pose-transfer result (used by tests, bench and `meshmorph compare`).
+//
+// A (#V by 3) is compared with B (#V by 3, same vertex order), both over faces F:
+// - vertex error (PMD): e_i = |a_i − b_i| / D, D = bounding-box diagonal of B;
+//   reported as mean_i e_i and max_i e_i. Use B = ground truth.
+// - Laplacian-coordinate magnitude change (detail preservation): with the uniform (umbrella)
+//   Laplacian δ_i = x_i − mean of x's neighbours, which is rotation invariant in magnitude,
+//   mean_i | |δ_i(A)| − |δ_i(B)| | / mean_i |δ_i(B)|. Use B = the source.
+// - edge-length distortion: | |e(A)| / |e(B)| − 1 | over undirected edges, mean and max.
+// - flipped faces: faces whose normal disagrees (negative dot product) with the area-weighted
+//   mean normal of their edge-neighbouring faces in A but clearly agrees (dot > 0.5) in B —
+//   local fold-overs (slivers with ambiguous normals in B are not counted),
+//   independent of the global rotation of a pose.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "common/status.h"
+
+namespace mm {
+
+struct TransferMetrics {
+  Status status;                    // InvalidArgument when A and B differ in size
+  double vertex_error_mean = 0;     // see header (bbox-diagonal units)
+  double vertex_error_max = 0;
+  double laplacian_change = 0;      // relative mean change of |δ|
+  double edge_distortion_mean = 0;  // relative
+  double edge_distortion_max = 0;
+  int flipped_faces = 0;
+};
+
+TransferMetrics transfer_metrics(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXi& F);
+
+}  // namespace mm

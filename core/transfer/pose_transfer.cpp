@@ -1,0 +1,249 @@
+#include "transfer/pose_transfer.h"
+
+#include <chrono>
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+#include "cage/mean_value_coordinates.h"
+#include "mesh/validate.h"
+#include "operators/operators.h"
+#include "spectral/spectral_basis.h"
+
+namespace mm {
+
+const char* transfer_method_name(TransferMethod m) {
+  switch (m) {
+    case TransferMethod::Yin: return "yin";
+    case TransferMethod::Kovnatsky: return "kovnatsky";
+    case TransferMethod::Levy: return "levy";
+  }
+  return "yin";
+}
+
+bool parse_transfer_method(const std::string& name, TransferMethod* m) {
+  if (name == "yin") *m = TransferMethod::Yin;
+  else if (name == "kovnatsky") *m = TransferMethod::Kovnatsky;
+  else if (name == "levy") *m = TransferMethod::Levy;
+  else return false;
+  return true;
+}
+
+namespace transfer_detail {
+
+double elapsed_ms(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// A mesh centred at its area-weighted centroid and scaled to unit surface area.
+struct Normalized {
+  Eigen::MatrixXd V;
+  Eigen::VectorXd mass;        // lumped areas of the normalized mesh (sum 1)
+  Eigen::RowVector3d centroid; // of the input
+  double scale = 1;            // sqrt(area of the input): V_input = centroid + scale · V
+};
+
+Status normalize(const Mesh& m, const char* which, Normalized* out) {
+  const Eigen::VectorXd a = mass_diagonal(m.V, m.F);
+  const double area = a.sum();
+  if (!(area > 0) || !std::isfinite(area))
+    return Status::error(StatusCode::InvalidMesh, std::string(which) + " mesh has zero surface area");
+  for (int i = 0; i < a.size(); ++i)
+    if (!(a[i] > 0))
+      return Status::error(StatusCode::InvalidMesh, std::string(which) + " mesh: vertex " + std::to_string(i) +
+                                                        " has zero area (unreferenced vertex or degenerate faces)");
+  out->centroid = (a.transpose() * m.V) / area;
+  out->scale = std::sqrt(area);
+  out->V = (m.V.rowwise() - out->centroid) / out->scale;
+  out->mass = a / area;
+  return Status::success();
+}
+
+}  // namespace transfer_detail
+
+PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, const std::vector<LandmarkPair>& landmarks,
+                                 const PoseTransferOptions& opt, const Progress& progress, const Mesh* user_cage) {
+  using namespace transfer_detail;
+  using clock = std::chrono::steady_clock;
+  const auto t_start = clock::now();
+  PoseTransferResult out;
+  const int K = opt.num_low_frequencies;
+  const int kp = opt.num_eigenpairs;
+  if (K < 0 || kp < K + 1 || opt.coupling.num_coupled < K + 1 || opt.coupling.num_coupled > kp) {
+    out.status = Status::error(StatusCode::InvalidArgument,
+                               "need 0 <= K < num_coupled <= num_eigenpairs (K = " + std::to_string(K) +
+                                   ", num_coupled = " + std::to_string(opt.coupling.num_coupled) +
+                                   ", num_eigenpairs = " + std::to_string(kp) + ")");
+    return out;
+  }
+  for (const auto& [mesh, name] : {std::pair<const Mesh*, const char*>{&reference, "reference"}, {&source, "source"}}) {
+    Status s = check_mesh(mesh->V, mesh->F);
+    if (!s.ok()) {
+      out.status = Status::error(s.code, std::string(name) + " mesh: " + s.message);
+      return out;
+    }
+    if (mesh->num_vertices() <= 2 * kp) {
+      out.status = Status::error(StatusCode::InvalidMesh,
+                                 std::string(name) + " mesh has " + std::to_string(mesh->num_vertices()) +
+                                     " vertices: too coarse for " + std::to_string(kp) +
+                                     " eigenpairs (needs more than " + std::to_string(2 * kp) + "); subdivide it");
+      return out;
+    }
+  }
+  // Landmarks.
+  const bool same_connectivity = reference.num_vertices() == source.num_vertices() && reference.F == source.F;
+  out.landmarks = landmarks;
+  if (out.landmarks.empty()) {
+    if (!same_connectivity) {
+      out.status = Status::error(StatusCode::InvalidArgument,
+                                 "the meshes have different connectivity (" + std::to_string(reference.num_vertices()) +
+                                     " and " + std::to_string(source.num_vertices()) +
+                                     " vertices): pass landmark pairs (reference vertex, source vertex)");
+      return out;
+    }
+    for (int v : farthest_point_landmarks(source.V, source.F, opt.landmarks.auto_count)) out.landmarks.push_back({v, v});
+  }
+  out.status = check_landmarks(out.landmarks, reference.num_vertices(), source.num_vertices(), opt.landmarks.min_landmarks);
+  if (!out.status.ok()) return out;
+
+  Normalized ref, src;
+  if (!(out.status = normalize(reference, "reference", &ref)).ok()) return out;
+  if (!(out.status = normalize(source, "source", &src)).ok()) return out;
+
+  // 2. Eigenbases.
+  auto t0 = clock::now();
+  SpectralBasisOptions so;
+  so.k = kp;
+  const SpectralBasis basis_ref =
+      spectral_basis(cotan_stiffness(ref.V, reference.F), ref.mass, so, progress.sub(0.0, 0.17));
+  if (!basis_ref.status.ok()) {
+    out.status = Status::error(basis_ref.status.code, "reference eigenbasis: " + basis_ref.status.message);
+    return out;
+  }
+  const SpectralBasis basis_src =
+      spectral_basis(cotan_stiffness(src.V, source.F), src.mass, so, progress.sub(0.17, 0.35));
+  if (!basis_src.status.ok()) {
+    out.status = Status::error(basis_src.status.code, "source eigenbasis: " + basis_src.status.message);
+    return out;
+  }
+  out.ms.eigenbases = elapsed_ms(t0);
+
+  // 3. Coupling.
+  t0 = clock::now();
+  const LandmarkFunctions lf = landmark_functions(reference.F, ref.mass, source.F, src.mass, out.landmarks, opt.landmarks);
+  if (!lf.status.ok()) {
+    out.status = lf.status;
+    return out;
+  }
+  Eigen::MatrixXd Phi_src, Phi_ref;  // the bases whose first K+1 columns carry the pose
+  if (opt.method == TransferMethod::Levy) {
+    // Plain eigenbases; reference signs matched to the source through the landmark functions.
+    Phi_src = basis_src.vectors;
+    Phi_ref = basis_ref.vectors;
+    const Eigen::MatrixXd Cs = Phi_src.transpose() * src.mass.asDiagonal() * lf.source;
+    const Eigen::MatrixXd Cr = Phi_ref.transpose() * ref.mass.asDiagonal() * lf.reference;
+    for (int i = 0; i < kp; ++i)
+      if (Cs.row(i).dot(Cr.row(i)) < 0) Phi_ref.col(i) = -Phi_ref.col(i);
+    const Eigen::MatrixXd Cr2 = Phi_ref.transpose() * ref.mass.asDiagonal() * lf.reference;
+    const int k = opt.coupling.num_coupled;
+    functional_matrix(Cs.topRows(k), Cr2.topRows(k), K + 1, &out.gamma, &out.gamma_dominance);
+    out.coupling_converged = true;
+  } else {
+    CoupledBasesOptions co = opt.coupling;
+    co.dominance_rows = K + 1;
+    const CoupledBases cb = coupled_bases(basis_src.vectors, basis_src.eigenvalues, src.mass, lf.source,
+                                          basis_ref.vectors, basis_ref.eigenvalues, ref.mass, lf.reference, co,
+                                          progress.sub(0.35, 0.4));
+    if (!cb.status.ok()) {
+      out.status = cb.status;
+      return out;
+    }
+    Phi_src = cb.source;
+    Phi_ref = cb.reference;
+    out.gamma = cb.gamma;
+    out.gamma_dominance = cb.diagonal_dominance;
+    out.coupling_iterations = cb.iterations;
+    out.coupling_converged = cb.converged;
+  }
+  out.ms.coupling = elapsed_ms(t0);
+
+  // Low-frequency coefficients (Eq. 3; A-weighted inner products of the A-orthonormal bases).
+  const Eigen::MatrixXd PhiK_src = Phi_src.leftCols(K + 1);
+  const Eigen::MatrixXd alpha_ref = Phi_ref.leftCols(K + 1).transpose() * ref.mass.asDiagonal() * ref.V;
+  const Eigen::MatrixXd alpha_src = PhiK_src.transpose() * src.mass.asDiagonal() * src.V;
+
+  Eigen::MatrixXd Vn;  // result in normalized coordinates
+  if (opt.method != TransferMethod::Yin) {
+    Vn = src.V + PhiK_src * (alpha_ref - alpha_src);  // Eq. 4
+  } else {
+    // 4. Cage.
+    t0 = clock::now();
+    Eigen::MatrixXd C;
+    Eigen::MatrixXi CF;
+    if (user_cage) {
+      C = user_cage->V;
+      CF = user_cage->F;
+      Status s = check_user_cage(source.V, C, &CF, opt.cage.min_clearance * 1e-3);
+      if (!s.ok()) {
+        out.status = s;
+        return out;
+      }
+    } else {
+      EnclosingCage cage = enclosing_cage(source.V, source.F, opt.cage, progress.sub(0.4, 0.6));
+      if (!cage.status.ok()) {
+        out.status = cage.status;
+        return out;
+      }
+      C = std::move(cage.V);
+      CF = std::move(cage.F);
+    }
+    out.cage_rest = C;
+    out.cage_faces = CF;
+    out.ms.cage = elapsed_ms(t0);
+
+    // 5. Mean-value coordinates (similarity invariant: computed in normalized coordinates).
+    t0 = clock::now();
+    const Eigen::MatrixXd Cn = (C.rowwise() - src.centroid) / src.scale;
+    const MeanValueCoordinates mvc = mean_value_coordinates(src.V, Cn, CF, progress.sub(0.6, 0.85));
+    if (!mvc.status.ok()) {
+      out.status = mvc.status;
+      return out;
+    }
+    out.ms.mvc = elapsed_ms(t0);
+
+    // 6. Optimisation (Eq. 12, App. B).
+    t0 = clock::now();
+    CagePoseProblem prob;
+    prob.C = Cn;
+    prob.CF = CF;
+    prob.P = PhiK_src.transpose() * src.mass.asDiagonal() * mvc.Psi;  // Eq. 8: Φ̂_Kᵀ A Ψ
+    prob.T = alpha_ref;
+    const CagePoseResult sol = solve_cage_pose(prob, opt.solver, progress.sub(0.85, 1.0));
+    if (!sol.status.ok()) {
+      out.status = sol.status;
+      return out;
+    }
+    out.iterations = sol.iterations;
+    out.converged = sol.converged;
+    out.energy = sol.energy;
+    out.energy_lf = sol.energy_lf;
+    out.energy_lc = sol.energy_lc;
+    out.energy_sf = sol.energy_sf;
+    Vn = mvc.Psi * sol.C;
+    const Eigen::RowVector3d place = opt.placement == TransferPlacement::Reference ? ref.centroid : src.centroid;
+    out.cage_deformed = (src.scale * sol.C).rowwise() + place;
+    out.ms.optimisation = elapsed_ms(t0);
+  }
+  const Eigen::RowVector3d place = opt.placement == TransferPlacement::Reference ? ref.centroid : src.centroid;
+  out.V = (src.scale * Vn).rowwise() + place;
+  if (!out.V.allFinite()) {
+    out.status = Status::error(StatusCode::NumericalError, "pose transfer produced non-finite positions");
+    return out;
+  }
+  out.ms.total = elapsed_ms(t_start);
+  progress.update("done", 1.0);
+  return out;
+}
+
+}  // namespace mm

@@ -1,0 +1,102 @@
+// Spectral pose transfer (Yin, Li, Lu, Ouyang, Zhang, Xian, "Spectral pose transfer", CAGD 2015
+// = paper 000, Sec. 3–4.2): the source mesh takes the pose of the reference mesh and keeps its
+// own details. The meshes may have different connectivity and proportions; landmark pairs tie
+// them together (not needed for same-connectivity pairs).
+//
+// Pipeline (each stage reports progress and can be cancelled):
+//  1. normalization: each mesh is centred at its area-weighted centroid and scaled to unit
+//     surface area, so eigenfunctions and coefficients of both speak the same units;
+//  2. eigenbases: the first k' generalized eigenpairs W φ = λ A φ of each mesh (paper 000 writes
+//     L = D⁻¹W with D = diag(1/aᵢ); the sound reading is A⁻¹W, solved as Wφ = λAφ);
+//  3. coupling: landmark functions (spectral/landmarks.h) and coupled quasi-harmonic bases
+//     (spectral/coupled_bases.h), with the functional matrix Γ;
+//  4. cage: automatic enclosing cage (cage/enclosing_cage.h) or the user's cage;
+//  5. mean-value coordinates Ψ of the source in its cage (V = ΨC);
+//  6. optimisation: the cage pose energy of Eq. 12 (transfer/cage_pose_solver.h) with the
+//     reference's first K+1 coupled coefficients α' as targets; Ṽ = Ψ C̃.
+// Baselines (method option): Lévy 2006 replaces the first K+1 coefficients in the plain
+// eigenbases (Eq. 4; reference eigenvector signs matched to the source through the landmark
+// functions), Kovnatsky 2013 does the same in the coupled bases (no cage, no optimisation).
+//
+// Output placement: the result has the source's surface area (its size) and sits at the
+// reference's centroid (or the source's, `placement`); its orientation is the reference's,
+// which is part of the pose that the low frequencies carry.
+//
+// Status codes: InvalidMesh (empty, non-finite or too coarse meshes, zero-area vertices),
+// InvalidArgument (bad options or landmarks: out of range, too few, repeated, missing for a
+// different-connectivity pair), NotConverged (eigensolver), NumericalError, Cancelled.
+// Non-manifold input (e.g. camel_ref's 26 non-manifold edges and flipped faces) is accepted:
+// every stage needs only triangles with positive area.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "cage/enclosing_cage.h"
+#include "common/progress.h"
+#include "common/status.h"
+#include "mesh/mesh.h"
+#include "spectral/coupled_bases.h"
+#include "spectral/landmarks.h"
+#include "transfer/cage_pose_solver.h"
+
+namespace mm {
+
+enum class TransferMethod {
+  Yin,        // paper 000: deformation in the cage subspace with low frequencies as handles
+  Kovnatsky,  // coefficient swap (Eq. 4) in coupled quasi-harmonic bases
+  Levy,       // coefficient swap (Eq. 4) in plain Laplace–Beltrami eigenbases
+};
+const char* transfer_method_name(TransferMethod m);  // "yin", "kovnatsky", "levy"
+bool parse_transfer_method(const std::string& name, TransferMethod* m);
+
+enum class TransferPlacement {
+  Reference,  // result centred where the reference is (compare directly with a ground truth)
+  Source,     // result centred where the source is
+};
+
+struct PoseTransferOptions {
+  TransferMethod method = TransferMethod::Yin;
+  int num_low_frequencies = 5;   // K: coefficients 0..K are transferred (paper 000 Sec. 4.2: K = 5)
+  int num_eigenpairs = 20;       // k': eigenpairs per mesh combined into the coupled bases
+  CoupledBasesOptions coupling;  // k (num_coupled = 10 ≥ K+1), μ, convergence test
+  LandmarkOptions landmarks;     // ring sizes, minimum count, generated count
+  EnclosingCageOptions cage;     // automatic cage (target ~300 vertices)
+  CagePoseOptions solver;        // λ₁ = λ₂ = 0.05, re-linearization tolerance
+  TransferPlacement placement = TransferPlacement::Reference;
+};
+
+struct PoseTransferTimings {     // wall-clock milliseconds per stage (informational)
+  double eigenbases = 0, coupling = 0, cage = 0, mvc = 0, optimisation = 0, total = 0;
+};
+
+struct PoseTransferResult {
+  Status status;                   // see header
+  Eigen::MatrixXd V;               // #V_source by 3: the source in the reference's pose
+  std::vector<LandmarkPair> landmarks; // pairs used (generated ones for same connectivity)
+  Eigen::MatrixXd gamma;           // k by k functional matrix of the bases used (coupled or plain)
+  double gamma_dominance = 0;      // min_i |Γ_ii| / Σ_{j≠i}|Γ_ij| over the first K+1 rows
+  int coupling_iterations = 0;     // coupled-bases gradient steps
+  bool coupling_converged = false;
+  Eigen::MatrixXd cage_rest;       // #C by 3 cage in source coordinates (Yin only)
+  Eigen::MatrixXd cage_deformed;   // #C by 3 deformed cage, output coordinates (Yin only)
+  Eigen::MatrixXi cage_faces;      // cage triangles
+  int iterations = 0;              // re-linearizations of the cage solve (Yin only)
+  bool converged = true;           // cage solve reached its tolerance (Yin only)
+  std::vector<double> energy;      // Eq. 12 energy after each iteration (Yin only)
+  double energy_lf = 0, energy_lc = 0, energy_sf = 0; // final unweighted terms (Yin only)
+  PoseTransferTimings ms;
+};
+
+// reference: the mesh whose pose is copied; source: the mesh that takes it. landmarks: pairs
+// (reference vertex, source vertex); may be empty when both meshes have the same faces (then
+// opt.landmarks.auto_count farthest-point landmarks are used). user_cage: optional closed cage
+// around the source (null = automatic).
+PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source,
+                                 const std::vector<LandmarkPair>& landmarks,
+                                 const PoseTransferOptions& opt = {}, const Progress& progress = {},
+                                 const Mesh* user_cage = nullptr);
+
+}  // namespace mm

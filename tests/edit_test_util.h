@@ -1,0 +1,187 @@
+// Shared helpers of the edit test files (tests/edit_test.cpp, tests/edit_probe_test.cpp).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "edit/laplacian_editor.h"
+#include "io/asset.h"
+#include "mesh/mesh.h"
+#include "test_support.h"
+
+namespace mm::edit_test {
+
+inline Mesh load(const std::string& rel) {
+  io::LoadResult r = io::load_asset(test::data_path(rel));
+  EXPECT_TRUE(r.status.ok()) << rel << ": " << r.status.message;
+  return r.asset.mesh();
+}
+
+// Vertices whose coordinate `axis` lies in the lowest / highest `fraction` of the extent.
+inline std::vector<int> slab(const Eigen::MatrixXd& V, int axis, double fraction, bool high) {
+  const double lo = V.col(axis).minCoeff(), hi = V.col(axis).maxCoeff();
+  std::vector<int> out;
+  for (int i = 0; i < V.rows(); ++i) {
+    const double t = (V(i, axis) - lo) / (hi - lo);
+    if (high ? t >= 1 - fraction : t <= fraction) out.push_back(i);
+  }
+  return out;
+}
+
+inline int long_axis(const Eigen::MatrixXd& V) {
+  Eigen::Index a;
+  (V.colwise().maxCoeff() - V.colwise().minCoeff()).maxCoeff(&a);
+  return static_cast<int>(a);
+}
+
+struct BarCase {
+  Mesh mesh;
+  EditRegion region;
+  HandleTransform transform;
+};
+
+// 1:4 midpoint subdivision (test helper: a finer tessellation of the same shape).
+inline Mesh subdivide(const Mesh& m) {
+  std::map<std::pair<int, int>, int> mid;
+  std::vector<Eigen::RowVector3d> P;
+  for (int i = 0; i < m.V.rows(); ++i) P.push_back(m.V.row(i));
+  auto midpoint = [&](int a, int b) {
+    auto key = std::make_pair(std::min(a, b), std::max(a, b));
+    auto it = mid.find(key);
+    if (it != mid.end()) return it->second;
+    P.push_back(0.5 * (m.V.row(a) + m.V.row(b)));
+    return mid[key] = static_cast<int>(P.size()) - 1;
+  };
+  Mesh out;
+  out.F.resize(4 * m.F.rows(), 3);
+  for (int f = 0; f < m.F.rows(); ++f) {
+    const int a = m.F(f, 0), b = m.F(f, 1), c = m.F(f, 2);
+    const int ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+    out.F.row(4 * f) << a, ab, ca;
+    out.F.row(4 * f + 1) << ab, b, bc;
+    out.F.row(4 * f + 2) << ca, bc, c;
+    out.F.row(4 * f + 3) << ab, bc, ca;
+  }
+  out.V.resize(P.size(), 3);
+  for (size_t i = 0; i < P.size(); ++i) out.V.row(static_cast<Eigen::Index>(i)) = P[i];
+  return out;
+}
+
+inline BarCase bar_case(bool bend, const std::string& file = "edit/bar.ply", int subdivisions = 0) {
+  BarCase b;
+  b.mesh = load(file);
+  for (int k = 0; k < subdivisions; ++k) b.mesh = subdivide(b.mesh);
+  const Eigen::MatrixXd& V = b.mesh.V;
+  const int ax = long_axis(V);
+  b.region.fixed = slab(V, ax, 0.1, false);
+  b.region.handles = {slab(V, ax, 0.1, true)};
+  Eigen::Vector3d c0 = Eigen::Vector3d::Zero(), ch = Eigen::Vector3d::Zero();
+  for (int v : b.region.fixed) c0 += V.row(v).transpose();
+  for (int v : b.region.handles[0]) ch += V.row(v).transpose();
+  c0 /= b.region.fixed.size();
+  ch /= b.region.handles[0].size();
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+  axis[ax] = 1;
+  if (!bend) {
+    b.transform = HandleTransform::similarity(Eigen::Vector3d::Zero(), axis, 150.0 * M_PI / 180.0, ch);
+    return b;
+  }
+  // Quarter circle of the same length in the plane of the long axis and the next axis.
+  const int up = (ax + 1) % 3;
+  Eigen::Vector3d e_up = Eigen::Vector3d::Zero();
+  e_up[up] = 1;
+  const double L = (ch - c0).norm(), rho = L / (M_PI / 2);
+  const Eigen::Vector3d target = c0 + rho * axis + rho * e_up;
+  const Eigen::Vector3d rot_axis = axis.cross(e_up);
+  b.transform = HandleTransform::similarity(target - ch, rot_axis, M_PI / 2, ch);
+  return b;
+}
+
+// Paper Fig. 3: a planar irregular triangulation. A jittered (n+1)×(n+1) grid in the z = 0 plane
+// with pseudo-random diagonals (fixed LCG seed), side 1:
+//   +--+--+
+//   |\ | /|    every vertex is coplanar with its neighbours → all are degenerate (Sec. 3.3);
+//   +--+--+    corners with one triangle have valence 2 (widened stencil).
+inline Mesh planar_patch(int n) {
+  Mesh m;
+  m.V.resize((n + 1) * (n + 1), 3);
+  unsigned state = 12345u;
+  auto rnd = [&]() {
+    state = state * 1664525u + 1013904223u;
+    return (state >> 8) / 16777216.0;
+  };
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      double x = i / double(n), y = j / double(n);
+      if (i > 0 && i < n) x += (rnd() - 0.5) * 0.5 / n;
+      if (j > 0 && j < n) y += (rnd() - 0.5) * 0.5 / n;
+      m.V.row(j * (n + 1) + i) << x, y, 0.0;
+    }
+  m.F.resize(2 * n * n, 3);
+  int f = 0;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;
+      if (rnd() < 0.5) {
+        m.F.row(f++) << a, b, d;
+        m.F.row(f++) << a, d, c;
+      } else {
+        m.F.row(f++) << a, b, c;
+        m.F.row(f++) << b, d, c;
+      }
+    }
+  return m;
+}
+
+// Distance of V.row(i) from the least-squares plane of its neighbours.
+inline double plane_distance(const Eigen::MatrixXd& V, int i, const std::vector<int>& ring) {
+  Eigen::MatrixXd P(ring.size(), 3);
+  for (size_t k = 0; k < ring.size(); ++k) P.row(static_cast<Eigen::Index>(k)) = V.row(ring[k]);
+  const Eigen::RowVector3d c = P.colwise().mean();
+  const Eigen::MatrixXd Q = P.rowwise() - c;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(Q.transpose() * Q);
+  return std::abs((V.row(i) - c).dot(es.eigenvectors().col(0).transpose()));
+}
+
+inline double quantile(Eigen::VectorXd v, double q) {
+  std::sort(v.data(), v.data() + v.size());
+  return v[static_cast<Eigen::Index>(q * (v.size() - 1))];
+}
+
+
+// The human_woman arm (T-pose, +x side): ROI = the arm beyond 35% of the half span, handle = the
+// hand beyond 90%; the rest of the body is outside the ROI (fixed).
+struct LimbCase {
+  Mesh mesh;
+  EditRegion region;
+  std::vector<int> free;  // ROI minus handle
+  double height = 0;
+};
+inline LimbCase limb_case(const std::string& file = "anim/human_woman.ply") {
+  LimbCase c;
+  c.mesh = load(file);
+  const Eigen::MatrixXd& V = c.mesh.V;
+  const double xmin = V.col(0).minCoeff(), xmax = V.col(0).maxCoeff();
+  const double xc = 0.5 * (xmin + xmax), half = 0.5 * (xmax - xmin);
+  std::vector<int> hand, roi;
+  for (int i = 0; i < V.rows(); ++i) {
+    const double t = (V(i, 0) - xc) / half;
+    if (t > 0.9) hand.push_back(i);
+    if (t > 0.35) roi.push_back(i);
+    if (t > 0.35 && t <= 0.9) c.free.push_back(i);
+  }
+  c.region.handles = {hand};
+  c.region.roi = roi;
+  c.height = V.col(1).maxCoeff() - V.col(1).minCoeff();
+  return c;
+}
+
+}  // namespace mm::edit_test

@@ -1,0 +1,139 @@
+// Bindings of the retarget module (paper 002) for the page's worker (web/src/ops/retarget.js).
+// Data conversion only: all work is io::RetargetSession (core/io/retarget_session.h).
+//
+// JS API:
+//   retargetPrepare(sourceBytes: Uint8Array, sourceName, targetBytes: Uint8Array, targetName,
+//                   targetJointsJson: string ("" = the target's skin), jointMapJson: string,
+//                   options?, progress?) → {ok, session: number, frames, times: Float64Array,
+//                   clip, targetPositions: Float32Array (#V·3 rest surface), targetIndices:
+//                   Uint32Array, warnings: string[]}
+//     options: {clip, fps, first_frame, last_frame, method: "harmonic"|"lbs",
+//               num_singularities, offset, w_affine, w_position, w_smooth, w_bone,
+//               bone_iterations, surface_descriptors, anchor_joint}
+//   retargetFrames(session, first, count, progress?) → {ok, positions: Float32Array
+//                   (count·#V·3, frame-major)}; progress returning false cancels (Cancelled)
+//   retargetExportGlb(session, positions: Float32Array|Float64Array (all frames, frame-major))
+//                   → {ok, bytes: Uint8Array}
+//   retargetDispose(session) → boolean
+#include <map>
+#include <memory>
+#include <string>
+
+#include <emscripten/bind.h>
+#include <emscripten/val.h>
+
+#include "convert.h"
+#include "io/asset.h"
+#include "io/retarget_session.h"
+
+namespace mm::wasm {
+namespace {
+
+struct RetargetSlot {
+  std::unique_ptr<io::RetargetSession> session;
+};
+std::map<int, RetargetSlot>& retarget_sessions() {
+  static std::map<int, RetargetSlot> s;
+  return s;
+}
+int g_next_retarget = 1;
+
+io::LoadResult load_bytes(const emscripten::val& bytes, const std::string& name) {
+  const auto fmt = io::format_from_path(name);
+  if (!fmt) {
+    io::LoadResult r;
+    r.status = Status::error(StatusCode::InvalidArgument, "unknown file type: " + name);
+    return r;
+  }
+  return io::load_asset_from_memory(to_bytes(bytes), *fmt, name);
+}
+
+emscripten::val retarget_prepare(emscripten::val src, std::string src_name, emscripten::val tgt, std::string tgt_name,
+                                 std::string joints, std::string map, emscripten::val options, emscripten::val progress) {
+  const io::LoadResult s = load_bytes(src, src_name);
+  if (!s.status.ok()) return status_object(s.status);
+  const io::LoadResult t = load_bytes(tgt, tgt_name);
+  if (!t.status.ok()) return status_object(t.status);
+  io::RetargetJobOptions o;
+  o.clip = get_string(options, "clip", o.clip);
+  o.fps = get_number(options, "fps", o.fps);
+  o.first_frame = get_int(options, "first_frame", o.first_frame);
+  o.last_frame = get_int(options, "last_frame", o.last_frame);
+  o.method = get_string(options, "method", "harmonic") == "lbs" ? io::RetargetMethod::Lbs : io::RetargetMethod::Harmonic;
+  HarmonicRetargetOptions& h = o.harmonic;
+  h.map.singularities.count = get_int(options, "num_singularities", h.map.singularities.count);
+  h.map.singularities.offset = get_number(options, "offset", h.map.singularities.offset);
+  h.w_affine = get_number(options, "w_affine", h.w_affine);
+  h.w_position = get_number(options, "w_position", h.w_position);
+  h.w_smooth = get_number(options, "w_smooth", h.w_smooth);
+  h.w_bone = get_number(options, "w_bone", h.w_bone);
+  h.bone_iterations = get_int(options, "bone_iterations", h.bone_iterations);
+  h.surface_descriptors = get_int(options, "surface_descriptors", h.surface_descriptors);
+  h.anchor_joint = get_string(options, "anchor_joint", h.anchor_joint);
+  auto session = std::make_unique<io::RetargetSession>();
+  const Status st = session->prepare(s.asset, t.asset, joints, map, o, js_progress(progress));
+  if (!st.ok()) return status_object(st);
+  emscripten::val out = status_object(st);
+  const int id = g_next_retarget++;
+  out.set("session", id);
+  out.set("frames", session->num_frames());
+  out.set("clip", session->clip_name());
+  Eigen::MatrixXd times(session->num_frames(), 1);
+  for (int k = 0; k < session->num_frames(); ++k) times(k, 0) = session->times()[k];
+  out.set("times", to_float64_array(times));
+  out.set("targetPositions", to_float32_array(session->target_rest()));
+  out.set("targetIndices", to_uint32_array(session->target_faces()));
+  emscripten::val warnings = emscripten::val::array();
+  for (const auto& w : session->warnings()) warnings.call<void>("push", w);
+  out.set("warnings", warnings);
+  retarget_sessions()[id].session = std::move(session);
+  return out;
+}
+
+emscripten::val retarget_frames(int id, int first, int count, emscripten::val progress) {
+  auto it = retarget_sessions().find(id);
+  if (it == retarget_sessions().end())
+    return status_object(Status::error(StatusCode::InvalidArgument, "unknown retarget session"));
+  std::vector<Eigen::MatrixXd> frames;
+  const Status st = it->second.session->frames(first, count, &frames, js_progress(progress));
+  if (!st.ok()) return status_object(st);
+  const int nv = static_cast<int>(it->second.session->target_rest().rows());
+  Eigen::MatrixXd all(static_cast<Eigen::Index>(frames.size()) * nv, 3);
+  for (size_t k = 0; k < frames.size(); ++k) all.middleRows(static_cast<Eigen::Index>(k) * nv, nv) = frames[k];
+  emscripten::val out = status_object(st);
+  out.set("positions", to_float32_array(all));
+  out.set("count", static_cast<int>(frames.size()));
+  return out;
+}
+
+emscripten::val retarget_export_glb(int id, emscripten::val positions) {
+  auto it = retarget_sessions().find(id);
+  if (it == retarget_sessions().end())
+    return status_object(Status::error(StatusCode::InvalidArgument, "unknown retarget session"));
+  const io::RetargetSession& s = *it->second.session;
+  const Eigen::MatrixXd all = to_matrix(positions, 3);
+  const int nv = static_cast<int>(s.target_rest().rows());
+  if (nv == 0 || all.rows() % nv != 0 || all.rows() / nv > s.num_frames())
+    return status_object(Status::error(StatusCode::InvalidArgument, "positions must hold whole frames of the target"));
+  std::vector<Eigen::MatrixXd> frames;
+  for (int k = 0; k < all.rows() / nv; ++k) frames.push_back(all.middleRows(static_cast<Eigen::Index>(k) * nv, nv));
+  std::vector<double> times(s.times().begin(), s.times().begin() + frames.size());
+  std::vector<uint8_t> bytes;
+  const Status st = s.write_glb(frames, times, &bytes);
+  if (!st.ok()) return status_object(st);
+  emscripten::val out = status_object(st);
+  out.set("bytes", to_uint8_array(bytes));
+  return out;
+}
+
+bool retarget_dispose(int id) { return retarget_sessions().erase(id) > 0; }
+
+}  // namespace
+}  // namespace mm::wasm
+
+EMSCRIPTEN_BINDINGS(meshmorph_retarget) {
+  emscripten::function("retargetPrepare", &mm::wasm::retarget_prepare);
+  emscripten::function("retargetFrames", &mm::wasm::retarget_frames);
+  emscripten::function("retargetExportGlb", &mm::wasm::retarget_export_glb);
+  emscripten::function("retargetDispose", &mm::wasm::retarget_dispose);
+}

@@ -1,0 +1,115 @@
+// Bindings of the transfer module (spectral pose transfer, paper 000) for the worker
+// (web/src/ops/transfer.js) and node tests. Conversion only; the work is core/transfer.
+//
+// JS API:
+//   poseTransfer(refPositions (#V'·3), refIndices (#F'·3), srcPositions (#V·3), srcIndices (#F·3),
+//                landmarks (Int32Array/Array of 2p: r0, s0, r1, s1, ...; empty for same connectivity),
+//                options?, progress?: (stage, fraction) => boolean, cagePositions?, cageIndices?)
+//     options (C++ field names, missing = default): {method: "yin"|"kovnatsky"|"levy",
+//       num_low_frequencies, num_eigenpairs, lambda1, lambda2, max_iterations, tolerance,
+//       num_coupled, mu, cage_vertices, placement: "reference"|"source"}
+//     → {ok, positions: Float64Array (#V·3), gamma: Float64Array (k·k, row-major), k,
+//        gammaDominance, iterations, converged, couplingIterations, cagePositions: Float64Array,
+//        cageRest: Float64Array, cageIndices: Uint32Array, energy: Float64Array,
+//        ms: {eigenbases, coupling, cage, mvc, optimisation, total}}
+//   transferMetrics(positionsA (#V·3), positionsB (#V·3), indices (#F·3))
+//     → {ok, vertexErrorMean, vertexErrorMax, laplacianChange, edgeDistortionMean,
+//        edgeDistortionMax, flippedFaces}
+#include <string>
+#include <vector>
+
+#include <emscripten/bind.h>
+#include <emscripten/val.h>
+
+#include "convert.h"
+#include "metrics/transfer_metrics.h"
+#include "transfer/pose_transfer.h"
+
+namespace mm::wasm {
+
+using emscripten::val;
+
+namespace {
+
+val pose_transfer_js(val ref_positions, val ref_indices, val src_positions, val src_indices, val landmarks,
+                     val options, val progress, val cage_positions, val cage_indices) {
+  try {
+    const Mesh ref{to_matrix(ref_positions), to_index_matrix(ref_indices)};
+    const Mesh src{to_matrix(src_positions), to_index_matrix(src_indices)};
+    const std::vector<int> flat = to_int_vector(landmarks);
+    if (flat.size() % 2 != 0)
+      return status_object(Status::error(StatusCode::InvalidArgument, "landmarks must hold pairs (reference, source)"));
+    std::vector<LandmarkPair> pairs;
+    for (size_t i = 0; i + 1 < flat.size(); i += 2) pairs.push_back({flat[i], flat[i + 1]});
+    PoseTransferOptions opt;
+    const std::string method = get_string(options, "method", "yin");
+    if (!parse_transfer_method(method, &opt.method))
+      return status_object(Status::error(StatusCode::InvalidArgument, "method must be yin, kovnatsky or levy"));
+    opt.num_low_frequencies = get_int(options, "num_low_frequencies", opt.num_low_frequencies);
+    opt.num_eigenpairs = get_int(options, "num_eigenpairs", opt.num_eigenpairs);
+    opt.solver.lambda1 = get_number(options, "lambda1", opt.solver.lambda1);
+    opt.solver.lambda2 = get_number(options, "lambda2", opt.solver.lambda2);
+    opt.solver.max_iterations = get_int(options, "max_iterations", opt.solver.max_iterations);
+    opt.solver.tolerance = get_number(options, "tolerance", opt.solver.tolerance);
+    opt.coupling.num_coupled = get_int(options, "num_coupled", opt.coupling.num_coupled);
+    opt.coupling.mu = get_number(options, "mu", opt.coupling.mu);
+    opt.cage.target_vertices = get_int(options, "cage_vertices", opt.cage.target_vertices);
+    opt.placement = get_string(options, "placement", "reference") == "source" ? TransferPlacement::Source
+                                                                              : TransferPlacement::Reference;
+    Mesh cage;
+    const bool has_cage = !cage_positions.isUndefined() && !cage_positions.isNull();
+    if (has_cage) cage = {to_matrix(cage_positions), to_index_matrix(cage_indices)};
+    const PoseTransferResult r = pose_transfer(ref, src, pairs, opt, js_progress(progress), has_cage ? &cage : nullptr);
+    val out = status_object(r.status);
+    if (!r.status.ok()) return out;
+    out.set("positions", to_float64_array(r.V));
+    Eigen::MatrixXd g = r.gamma;
+    out.set("gamma", to_float64_array(g));
+    out.set("k", static_cast<int>(g.rows()));
+    out.set("gammaDominance", r.gamma_dominance);
+    out.set("iterations", r.iterations);
+    out.set("converged", r.converged);
+    out.set("couplingIterations", r.coupling_iterations);
+    out.set("cagePositions", to_float64_array(r.cage_deformed));
+    out.set("cageRest", to_float64_array(r.cage_rest));
+    out.set("cageIndices", to_uint32_array(r.cage_faces));
+    out.set("energy", to_float64_array(Eigen::Map<const Eigen::MatrixXd>(r.energy.data(), r.energy.size(), 1)));
+    val ms = val::object();
+    ms.set("eigenbases", r.ms.eigenbases);
+    ms.set("coupling", r.ms.coupling);
+    ms.set("cage", r.ms.cage);
+    ms.set("mvc", r.ms.mvc);
+    ms.set("optimisation", r.ms.optimisation);
+    ms.set("total", r.ms.total);
+    out.set("ms", ms);
+    return out;
+  } catch (const std::exception& e) {
+    val out = val::object();
+    out.set("ok", false);
+    out.set("code", std::string("Internal"));
+    out.set("message", std::string("pose transfer: ") + e.what());
+    return out;
+  }
+}
+
+val transfer_metrics_js(val a, val b, val indices) {
+  const TransferMetrics m = transfer_metrics(to_matrix(a), to_matrix(b), to_index_matrix(indices));
+  val out = status_object(m.status);
+  if (!m.status.ok()) return out;
+  out.set("vertexErrorMean", m.vertex_error_mean);
+  out.set("vertexErrorMax", m.vertex_error_max);
+  out.set("laplacianChange", m.laplacian_change);
+  out.set("edgeDistortionMean", m.edge_distortion_mean);
+  out.set("edgeDistortionMax", m.edge_distortion_max);
+  out.set("flippedFaces", m.flipped_faces);
+  return out;
+}
+
+}  // namespace
+
+EMSCRIPTEN_BINDINGS(meshmorph_transfer) {
+  emscripten::function("poseTransfer", &pose_transfer_js);
+  emscripten::function("transferMetrics", &transfer_metrics_js);
+}
+
+}  // namespace mm::wasm
