@@ -13,6 +13,9 @@
 #include "edit/implicit_gradients.h"
 #include "edit/laplacian_editor.h"
 #include "edit/selection.h"
+#include "edit/supernodal_cholesky.h"
+#include "linalg/spd_solver.h"
+#include "operators/operators.h"
 #include "edit_test_util.h"
 #include "mesh/topology.h"
 #include "metrics/edit_metrics.h"
@@ -565,6 +568,36 @@ TEST(Edit, SpecParsing) {
   EXPECT_EQ(s.code, StatusCode::ParseError);
   EXPECT_EQ(parse_handle_transforms("[{}, {}]", V, b.region).status.code, StatusCode::InvalidArgument);
   EXPECT_EQ(parse_handle_transforms(R"([{"matrix": [1]}])", V, b.region).status.code, StatusCode::ParseError);
+}
+
+// The supernodal factorization solves the same systems as the simplicial LDLT: a 2-ring
+// (cotangent LᵀL + identity) matrix of a real mesh, several right-hand sides; and reports
+// non-SPD matrices.
+TEST(Edit, SupernodalCholeskyMatchesSimplicial) {
+  Mesh m = load("edit/decimated-knight.ply");
+  const SparseMatrix W = cotan_stiffness(m.V, m.F);
+  SparseMatrix I(W.rows(), W.cols());
+  I.setIdentity();
+  const SparseMatrix A = SparseMatrix(W.transpose()) * W + 1e-2 * I;
+  SupernodalCholesky sn;
+  ASSERT_TRUE(sn.factor(A).ok());
+  EXPECT_GT(sn.supernodes(), 0);
+  SpdSolver ref;
+  ASSERT_TRUE(ref.factor(A).ok());
+  Eigen::MatrixXd B(W.rows(), 5);
+  for (int i = 0; i < B.rows(); ++i)
+    for (int c = 0; c < 5; ++c) B(i, c) = std::sin(1.0 + i * 0.37 + c * 1.3);
+  Eigen::MatrixXd X, Xr;
+  ASSERT_TRUE(sn.solve(B, &X).ok());
+  ASSERT_TRUE(ref.solve(B, &Xr).ok());
+  EXPECT_LE((X - Xr).cwiseAbs().maxCoeff(), 1e-8 * Xr.cwiseAbs().maxCoeff());
+  EXPECT_LE((A * X - B).cwiseAbs().maxCoeff(), 1e-8 * B.cwiseAbs().maxCoeff());
+  // Indefinite: flip one diagonal entry far negative.
+  SparseMatrix Bad = A;
+  Bad.coeffRef(7, 7) = -1.0;
+  EXPECT_EQ(sn.factor(Bad).code, StatusCode::FactorizationFailed);
+  // Singular: the pure Laplacian has constants in its null space.
+  EXPECT_EQ(sn.factor(SparseMatrix(W.transpose()) * W).code, StatusCode::FactorizationFailed);
 }
 
 // Golden outputs shared by the native and wasm runs (tolerance 1e-7 in mesh units: the two

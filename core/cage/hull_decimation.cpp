@@ -54,7 +54,8 @@ struct Quadric {
 
 struct HeapEntry {
   double cost;
-  int a, b;  // a < b
+  int a, b;         // a < b
+  unsigned va, vb;  // versions of a and b when pushed (lazy deletion: stale when either changed)
   // Priority: lower cost first, ties by vertex indices (deterministic).
   bool before(const HeapEntry& o) const {
     if (cost != o.cost) return cost < o.cost;
@@ -63,9 +64,10 @@ struct HeapEntry {
   }
 };
 
-// 4-ary min-heap of 16-byte entries. Edge collapses leave many stale entries behind, and a
-// binary heap of that size spends most of its time in cache misses; four children per node
-// halve the depth and share cache lines.
+// 4-ary min-heap of 24-byte entries. Edge collapses leave many stale entries behind (lazy
+// deletion: an entry is skipped when popped if a vertex it names died or changed since, which
+// the version stamps tell without recomputing the cost); four children per node halve the depth
+// of a binary heap and share cache lines.
 class EdgeHeap {
  public:
   bool empty() const { return h_.empty(); }
@@ -194,6 +196,7 @@ class Decimator {
     vf_.resize(n);
     quadric_.resize(n);
     vert_alive_.assign(n, 0);
+    version_.assign(n, 0);
     for (int f = 0; f < F.rows(); ++f) {
       faces_[f] = {F(f, 0), F(f, 1), F(f, 2)};
       for (int c = 0; c < 3; ++c) {
@@ -228,9 +231,10 @@ class Decimator {
       const HeapEntry e = heap_.pop();
       if (!vert_alive_[e.a] || !vert_alive_[e.b]) continue;
       // The cost depends only on the state of a and b; when either changed, a fresh entry was
-      // pushed and this one is stale (a different cost). An equal cost describes the present.
+      // pushed with the new versions and this one is stale.
+      if (e.va != version_[e.a] || e.vb != version_[e.b]) continue;
       const Candidates c = candidates(e.a, e.b);
-      if (c.n == 0 || c.cost[0] != e.cost) continue;
+      if (c.n == 0) continue;
       if (!collapse(e.a, e.b, c)) continue;
       ++done;
       if (alive_faces_ * 2 < grid_faces_) rebuild_grid();
@@ -330,7 +334,7 @@ class Decimator {
 
   void push(int a, int b) {
     const Candidates c = candidates(a, b);
-    if (c.n > 0) heap_.push({c.cost[0], a, b});
+    if (c.n > 0) heap_.push({c.cost[0], a, b, version_[a], version_[b]});
   }
 
   bool collapse(int a, int b, const Candidates& cands) {
@@ -417,6 +421,7 @@ class Decimator {
     for (int f : edge_faces) face_alive_[f] = 0;
     alive_faces_ -= 2;
     pos_[a] = p;
+    ++version_[a];
     quadric_[a].add(quadric_[b]);
     for (int f : faces_of(b)) {
       for (int c = 0; c < 3; ++c)
@@ -551,6 +556,7 @@ class Decimator {
   std::vector<std::vector<int>> vf_;
   std::vector<Quadric> quadric_;
   std::vector<uint8_t> vert_alive_;
+  std::vector<unsigned> version_;  // bumped whenever a vertex moves (heap lazy deletion)
   EdgeHeap heap_;
   int alive_vertices_ = 0, alive_faces_ = 0, grid_faces_ = 0;
   // grid over faces

@@ -13,6 +13,7 @@
 
 #include "edit/implicit_gradients.h"
 #include "edit/selection.h"
+#include "edit/supernodal_cholesky.h"
 #include "linalg/polar.h"
 #include "linalg/spd_solver.h"
 #include "mesh/topology.h"
@@ -196,8 +197,8 @@ struct LaplacianEditor::Impl {
   std::vector<int> stencil_local;  // grads.stencil mapped to local numbering (-1 outside)
   std::vector<int> displaced_unknowns;  // local unknowns displaced by Eq. 8
 
-  // Stage 1 (Eq. 7).
-  SpdSolver solver1;
+  // Stage 1 (Eq. 7): AᵀA has a 4-ring pattern; the supernodal factor is 3–5× faster there.
+  SupernodalCholesky solver1;
   edit_detail::Sparse Q1;        // nU by nK: the block N_UK of AᵀA
   Eigen::MatrixXd G1;            // nU by 3·H: gradient-constraint right-hand side per handle
   Eigen::MatrixXd Phi0;          // nU by 3
@@ -392,7 +393,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
   } else {
     Vd = V;
   }
-  if (!progress.update("edit: stencils", 1.0)) return cancelled_status("edit: stencils");
+  if (!progress.update("edit: stencils", 0.05)) return cancelled_status("edit: stencils");
   stats.stencil_ms = lap_ms(&clock);
 
   // ---- local numbering
@@ -505,7 +506,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
       D2_UK = Ds.rightCols(nL - nU);
     }
     dbg_lap("poisson assembly");
-    if (!progress.update("edit: poisson factor", 0.0)) return cancelled_status("edit: poisson factor");
+    if (!progress.update("edit: poisson factor", 0.06)) return cancelled_status("edit: poisson factor");
     Sparse N2;
     if (!soft_mode) {
       N2 = D2_UU;
@@ -518,7 +519,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
       return Status::error(s.code, "Poisson system (Eq. 9/10): " + s.message);
     stats.poisson_ms = lap_ms(&clock);
   }
-  if (!progress.update("edit: assembling", 0.0)) return cancelled_status("edit: assembling");
+  if (!progress.update("edit: assembling", 0.1)) return cancelled_status("edit: assembling");
 
   if (implicit) {
     // ---- stage 1 normal equations N = AᵀA over local numbering (same for x, y, z).
@@ -550,7 +551,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     dbg_lap("E_L rows");
     Sparse N = Sparse(E.transpose()) * E;
     dbg_lap("EtE");
-    if (!progress.update("edit: assembling", 0.3)) return cancelled_status("edit: assembling");
+    if (!progress.update("edit: assembling", 0.15)) return cancelled_status("edit: assembling");
 
     // E_R (Eq. 6) over SF = pairs within r rings, at least one of them active:
     // Σ_pairs ||M_a − M_b||²_F = Σ_c xᵀ K_c G K_cᵀ x with G the pair-graph Laplacian.
@@ -608,7 +609,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
       N += Sparse(KG * Sparse(Khat.transpose()));
     }
     dbg_lap("KGK");
-    if (!progress.update("edit: assembling", 0.8)) return cancelled_status("edit: assembling");
+    if (!progress.update("edit: assembling", 0.3)) return cancelled_status("edit: assembling");
 
     // Optional transformation constraints M_k = A_h at handle vertices (Eq. 7).
     G1 = Eigen::MatrixXd::Zero(nU, 3 * num_handles);
@@ -639,13 +640,14 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     stats.system_nonzeros = static_cast<long>(Sparse(NUU.triangularView<Eigen::Lower>()).nonZeros());
     dbg_lap("split");
     stats.assembly_ms = lap_ms(&clock);
-    if (!progress.update("edit: factor", 0.0)) return cancelled_status("edit: factor");
-    if (Status s = solver1.factor(NUU); !s.ok())
+    if (!progress.update("edit: factor", 0.35)) return cancelled_status("edit: factor");
+    if (Status s = solver1.factor(NUU, progress.sub(0.35, 0.9)); !s.ok())
       return Status::error(s.code, "implicit editing system (Eq. 7): " + s.message +
                                        ". The handles may not determine a rotation: constrain at least 3 "
                                        "non-collinear vertices");
     stats.factor_ms = lap_ms(&clock);
-    if (!progress.update("edit: factor", 1.0)) return cancelled_status("edit: factor");
+    stats.factor_nonzeros = solver1.factor_entries();
+    if (!progress.update("edit: factor", 0.9)) return cancelled_status("edit: factor");
 
     // ---- handle response basis: Φ_0 for the fixed part, Φ_h (4 columns) per handle.
     if (opt.handle_basis) {
@@ -675,7 +677,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
         }
       }
       for (int hh = 0; hh < num_handles; ++hh) R.block(0, 3 + 4 * hh, nU, 3) += G1.block(0, 3 * hh, nU, 3);
-      if (!progress.update("edit: handle basis", 0.0)) return cancelled_status("edit: handle basis");
+      if (!progress.update("edit: handle basis", 0.9)) return cancelled_status("edit: handle basis");
       Eigen::MatrixXd X;
       if (Status s = solver1.solve(R, &X); !s.ok()) return s;
       Phi0 = X.leftCols(3);

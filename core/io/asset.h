@@ -21,8 +21,12 @@
 // Status codes: IoError (file missing/unreadable/unwritable, refused or missing external URI),
 // ParseError (malformed contents: empty file, truncated GLB, bad JSON, indices out of range,
 // counts larger than the data, OBJ index 0), Unsupported (unknown extension, non-triangle glTF
-// primitives, binary OFF, compressed glTF geometry), InvalidArgument / NumericalError (save:
-// wrong shape or non-finite positions). NaN coordinates load fine; mesh/validate.h reports them.
+// primitives, binary OFF, compressed glTF geometry), InvalidMesh (a glTF scene without
+// triangle primitives), InvalidArgument / NumericalError (save: wrong shape or non-finite
+// positions). NaN coordinates load fine; mesh/validate.h reports them.
+//
+// .gltf vs .glb is decided by the content ("glTF" magic), so Asset::format can differ from the
+// format passed in when a file has the wrong extension.
 //
 // glTF documents: code inside core/io (and the retarget export) reaches the tinygltf::Model
 // through io/gltf_document.h.
