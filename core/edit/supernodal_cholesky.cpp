@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
 
 #include <Eigen/Cholesky>
 #include <Eigen/OrderingMethods>
@@ -105,6 +108,13 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     return Status::success();
   }
 
+  auto dbg_t = std::chrono::steady_clock::now();
+  const bool dbg = std::getenv("MM_EDIT_DEBUG") != nullptr;
+  auto dbg_lap = [&](const char* what) {
+    const auto now = std::chrono::steady_clock::now();
+    if (dbg) std::fprintf(stderr, "  [sn] %s %.1f ms\n", what, std::chrono::duration<double, std::milli>(now - dbg_t).count());
+    dbg_t = now;
+  };
   // ---- ordering: AMD, then a postorder of the elimination tree (same fill, contiguous subtrees).
   {
     const Sparse full = A.selfadjointView<Eigen::Lower>();
@@ -124,6 +134,7 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
   }
   const Sparse U = C.transpose();
   const std::vector<int> parent = elimination_tree(U);
+  dbg_lap("ordering+postorder+etree");
   if (!progress.update("factor: analysis", 0.5)) return cancelled_status("factor");
 
   // ---- column counts of L (off-diagonal) by row subtrees: O(nnz(L)).
@@ -206,6 +217,8 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     total_flops += static_cast<double>(ncols) * m * m;
   }
   values_.assign(static_cast<size_t>(value_ptr_.back()), 0.0);
+  dbg_lap("symbolic");
+  if (dbg) std::fprintf(stderr, "  [sn] n %d supernodes %d (fundamental %zu) entries %ld flops %.2f G\n", n, ns, fundamental.size() - 1, (long)values_.size(), total_flops / 1e9);
   if (!progress.update("factor: analysis", 1.0)) return cancelled_status("factor");
 
   // ---- numeric multifrontal factorization in postorder; update matrices on a stack.
@@ -263,6 +276,7 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
       if (!progress.update("factor", done_flops / total_flops)) return cancelled_status("factor");
     }
   }
+  dbg_lap("numeric");
   // Relative pivot check, as SpdSolver does: a tiny pivot means a numerically singular matrix.
   double max_d = 0, min_d = std::numeric_limits<double>::infinity();
   for (int s = 0; s < ns; ++s) {

@@ -22,14 +22,19 @@ std::vector<int> farthest_point_sampling(const Eigen::MatrixXd& P, int count, in
     chosen.push_back(next);
     last = std::sqrt(d2[next]);
     d2[next] = -1;  // chosen points never come back
-    const Eigen::RowVector3d q = P.row(next);
+    const double qx = P(next, 0), qy = P(next, 1), qz = P(next, 2);
     int best = -1;
     double best_d = -1;
     for (int i = 0; i < n; ++i) {
       if (d2[i] < 0) continue;
-      const double d = (P.row(i) - q).squaredNorm();
+      // Fixed evaluation order (no vectorised reduction), so native and wasm round alike.
+      const double dx = P(i, 0) - qx, dy = P(i, 1) - qy, dz = P(i, 2) - qz;
+      const double d = (dx * dx + dy * dy) + dz * dz;
       if (d < d2[i]) d2[i] = d;
-      if (d2[i] > best_d) {  // strict: the lower index wins ties
+      // Near-ties (regular samplings have many exact ties in exact arithmetic) go to the lower
+      // index: a point must be farther by a relative 1e-9 to win, so last-bit differences of the
+      // inputs between platforms (libm, SIMD) do not change which point is chosen.
+      if (d2[i] > best_d * (1 + 1e-9) + 1e-300) {
         best_d = d2[i];
         best = i;
       }
