@@ -219,4 +219,28 @@ TEST(EditProbe, DISABLED_Soft) {
   }
 }
 
+// Exact numbers behind the docs: configuration-invariance error, identity error.
+TEST(EditProbe, DISABLED_Invariance) {
+  BarCase b = bar_case(true);
+  const Eigen::MatrixXd& V = b.mesh.V;
+  const HandleTransform T = HandleTransform::similarity(Eigen::Vector3d(0.3, -0.2, 0.5), Eigen::Vector3d(1, 2, 3), 2.0,
+                                                        Eigen::Vector3d(0.1, 0.1, 0.1), 1.7);
+  EditRegion region;
+  region.handles = {b.region.handles[0], b.region.fixed};
+  Eigen::MatrixXd expected(V.rows(), 3);
+  for (int i = 0; i < V.rows(); ++i) expected.row(i) = T.apply(V.row(i).transpose()).transpose();
+  LaplacianEditor ed;
+  ASSERT_TRUE(ed.precompute(V, b.mesh.F, region).ok());
+  const double diag = bounding_box_diagonal(V);
+  EditResult p = ed.drag({T, T});
+  EditResult f = ed.finalize(FeatureSize::Scale);
+  std::printf("invariance: preview %.3g·diag, finalize(scale) %.3g·diag\n", (p.V - expected).cwiseAbs().maxCoeff() / diag,
+              (f.V - expected).cwiseAbs().maxCoeff() / diag);
+  LaplacianEditor id;
+  ASSERT_TRUE(id.precompute(V, b.mesh.F, b.region).ok());
+  EditResult q = id.drag({HandleTransform{}});
+  EditResult g = id.finalize();
+  std::printf("identity: preview %.3g, finalize %.3g\n", (q.V - V).cwiseAbs().maxCoeff(), (g.V - V).cwiseAbs().maxCoeff());
+}
+
 }  // namespace

@@ -13,6 +13,8 @@
 #include "edit/implicit_gradients.h"
 #include "edit/laplacian_editor.h"
 #include "edit/selection.h"
+#include "edit/shear_removal.h"
+#include "linalg/polar.h"
 #include "edit/supernodal_cholesky.h"
 #include "linalg/spd_solver.h"
 #include "operators/operators.h"
@@ -598,6 +600,29 @@ TEST(Edit, SupernodalCholeskyMatchesSimplicial) {
   EXPECT_EQ(sn.factor(Bad).code, StatusCode::FactorizationFailed);
   // Singular: the pure Laplacian has constants in its null space.
   EXPECT_EQ(sn.factor(SparseMatrix(W.transpose()) * W).code, StatusCode::FactorizationFailed);
+}
+
+// The fast rotation extraction agrees with the SVD-based polar decomposition, including the
+// fallback cases (near-singular, reflected).
+TEST(Edit, RotationPartMatchesPolarDecomposition) {
+  unsigned state = 7u;
+  auto rnd = [&]() {
+    state = state * 1664525u + 1013904223u;
+    return (state >> 8) / 16777216.0 - 0.5;
+  };
+  double worst = 0;
+  for (int k = 0; k < 200; ++k) {
+    Eigen::Matrix3d M;
+    for (int i = 0; i < 9; ++i) M.data()[i] = rnd();
+    if (k % 3 == 0) M = Eigen::AngleAxisd(3 * rnd(), Eigen::Vector3d(rnd(), rnd(), rnd()).normalized()) * (0.8 * Eigen::Matrix3d::Identity() + 0.3 * M);
+    if (k == 1) M.col(2) = M.col(0) * 2.0;  // singular
+    if (k == 2) M.col(1) *= -1.0;          // (possibly) reflected
+    const Eigen::Matrix3d R = rotation_part(M);
+    worst = std::max(worst, (R - polar_decomposition(M).R).cwiseAbs().maxCoeff());
+    EXPECT_NEAR(R.determinant(), 1.0, 1e-9);
+  }
+  EXPECT_LE(worst, 1e-8);
+  EXPECT_TRUE(rotation_part(Eigen::Matrix3d::Constant(std::numeric_limits<double>::quiet_NaN())).isIdentity());
 }
 
 // Golden outputs shared by the native and wasm runs (tolerance 1e-7 in mesh units: the two

@@ -109,10 +109,15 @@ TEST(TransferDifferentConnectivity, CatToLionGoldenAndDeterministic) {
   const PoseTransferResult b = pose_transfer(cat, lion, pairs);
   ASSERT_TRUE(b.status.ok());
   EXPECT_TRUE(a.V == b.V) << "two runs differ";
-  // Golden (shared by the native and wasm runs): every 50th vertex.
+  // Golden (shared by the native and wasm runs): every 50th vertex. Tolerance 1e-3 mesh units
+  // (≈ 1e-3 of the lion's 1.09 bbox diagonal, 100× below the pose error above): the cage is
+  // bit-identical on both targets, but the eigensolver (Eigen vectorises with SSE natively,
+  // not in wasm) and libm (glibc vs musl) differ in the last bits, and the iterative coupling and
+  // the re-linearized cage solve amplify that to ~2.4e-4 (measured wasm vs native). Within one
+  // target the result is bit-identical (checked above).
   Eigen::MatrixXd sample((a.V.rows() + 49) / 50, 3);
   for (int i = 0; i < sample.rows(); ++i) sample.row(i) = a.V.row(50 * i);
-  test::expect_golden("transfer_cat01_lion", sample, 1e-4);
+  test::expect_golden("transfer_cat01_lion", sample, 1e-3);
 }
 
 TEST(TransferErrors, BadInputsGiveClearStatus) {

@@ -215,6 +215,7 @@ class Decimator {
     for (int i = 0; i < n; ++i) alive_vertices_ += vert_alive_[i];
     alive_faces_ = static_cast<int>(F.rows());
     stamp_.assign(F.rows(), 0);
+    face_version_.assign(F.rows(), 0);
     cos_turn_ = std::cos(opt_.max_normal_turn_deg * kPi / 180.0);
   }
 
@@ -484,23 +485,39 @@ class Decimator {
     return {pos_[faces_[f][0]], pos_[faces_[f][1]], pos_[faces_[f][2]]};
   }
 
+  // Float box that contains the double box [lo, hi] (rounded outward).
+  static void float_box(const Vec3& lo, const Vec3& hi, float flo[3], float fhi[3]) {
+    for (int k = 0; k < 3; ++k) {
+      flo[k] = static_cast<float>(lo[k]);
+      if (static_cast<double>(flo[k]) > lo[k]) flo[k] = std::nextafter(flo[k], -HUGE_VALF);
+      fhi[k] = static_cast<float>(hi[k]);
+      if (static_cast<double>(fhi[k]) < hi[k]) fhi[k] = std::nextafter(fhi[k], HUGE_VALF);
+    }
+  }
+
   void grid_insert(int f) {
     Vec3 lo, hi;
     bbox(face_points(f), &lo, &hi);
+    CellEntry e;
+    e.f = f;
+    e.version = ++face_version_[f];
+    float_box(lo, hi, e.lo, e.hi);
     int r0[3], r1[3];
     cell_range(lo, hi, r0, r1);
     for (int z = r0[2]; z <= r1[2]; ++z)
       for (int y = r0[1]; y <= r1[1]; ++y)
         for (int x = r0[0]; x <= r1[0]; ++x) {
           auto& cell = cells_[x + static_cast<size_t>(dims_[0]) * (y + static_cast<size_t>(dims_[1]) * z)];
-          // Faces are re-inserted after every change: drop dead entries and duplicates whenever
+          // Faces are re-inserted after every change: drop dead and superseded entries whenever
           // a cell doubles so cells stay short.
           if (cell.size() >= 16 && (cell.size() & (cell.size() - 1)) == 0) {
-            std::sort(cell.begin(), cell.end());
-            cell.erase(std::unique(cell.begin(), cell.end()), cell.end());
-            cell.erase(std::remove_if(cell.begin(), cell.end(), [&](int g) { return !face_alive_[g]; }), cell.end());
+            cell.erase(std::remove_if(cell.begin(), cell.end(),
+                                      [&](const CellEntry& c) {
+                                        return !face_alive_[c.f] || c.version != face_version_[c.f];
+                                      }),
+                       cell.end());
           }
-          cell.push_back(f);
+          cell.push_back(e);
         }
   }
 
@@ -523,8 +540,14 @@ class Decimator {
       for (int y = r0[1]; y <= r1[1]; ++y)
         for (int x = r0[0]; x <= r1[0]; ++x) {
           const auto& cell = cells_[x + static_cast<size_t>(dims_[0]) * (y + static_cast<size_t>(dims_[1]) * z)];
-          for (int g : cell) {
-            if (stamp_[g] == query_ || !face_alive_[g]) continue;
+          for (const CellEntry& ce : cell) {
+            // The entry's stored box (rounded outward) rejects most candidates without touching
+            // the face arrays; superseded entries (the face moved since) are skipped.
+            if (ce.lo[0] > hi.x || ce.lo[1] > hi.y || ce.lo[2] > hi.z || ce.hi[0] < lo.x || ce.hi[1] < lo.y ||
+                ce.hi[2] < lo.z)
+              continue;
+            const int g = ce.f;
+            if (ce.version != face_version_[g] || stamp_[g] == query_ || !face_alive_[g]) continue;
             stamp_[g] = query_;
             const auto& t = faces_[g];
             if (has_vertex(t, a) || has_vertex(t, b)) continue;  // part of the star
@@ -563,7 +586,13 @@ class Decimator {
   Vec3 grid_lo_;
   double cell_ = 1;
   int dims_[3] = {1, 1, 1};
-  std::vector<std::vector<int>> cells_;
+  struct CellEntry {
+    int f;
+    unsigned version;  // face_version_[f] when inserted
+    float lo[3], hi[3];  // bounding box of the face then, rounded outward
+  };
+  std::vector<std::vector<CellEntry>> cells_;
+  std::vector<unsigned> face_version_;
   std::vector<unsigned> stamp_;
   unsigned query_ = 0;
 };

@@ -12,10 +12,10 @@ namespace mm {
 
 namespace edit_spec_detail {
 
-using Json = nlohmann::json;
+using EditSpecJson = nlohmann::json;
 
 // Parsing context: the first error wins; every accessor checks types so nlohmann never throws.
-struct Parser {
+struct EditSpecParser {
   const Eigen::MatrixXd& V;
   const Eigen::MatrixXi& F;
   double diag = 1;
@@ -25,30 +25,30 @@ struct Parser {
     if (status.ok()) status = Status::error(code, msg);
     return false;
   }
-  bool check_keys(const Json& obj, const std::set<std::string>& allowed, const std::string& where) {
+  bool check_keys(const EditSpecJson& obj, const std::set<std::string>& allowed, const std::string& where) {
     for (auto it = obj.begin(); it != obj.end(); ++it)
       if (!allowed.count(it.key())) return fail(StatusCode::ParseError, "unknown key \"" + it.key() + "\" in " + where);
     return true;
   }
-  bool number(const Json& j, const std::string& where, double* out) {
+  bool number(const EditSpecJson& j, const std::string& where, double* out) {
     if (!j.is_number()) return fail(StatusCode::ParseError, where + " must be a number");
     *out = j.get<double>();
     if (!std::isfinite(*out)) return fail(StatusCode::InvalidArgument, where + " must be finite");
     return true;
   }
-  bool integer(const Json& j, const std::string& where, int* out) {
+  bool integer(const EditSpecJson& j, const std::string& where, int* out) {
     if (!j.is_number_integer()) return fail(StatusCode::ParseError, where + " must be an integer");
     *out = j.get<int>();
     return true;
   }
-  bool vec3(const Json& j, const std::string& where, Eigen::Vector3d* out) {
+  bool vec3(const EditSpecJson& j, const std::string& where, Eigen::Vector3d* out) {
     if (!j.is_array() || j.size() != 3) return fail(StatusCode::ParseError, where + " must be an array of 3 numbers");
     for (int k = 0; k < 3; ++k)
       if (!number(j[k], where + "[" + std::to_string(k) + "]", &(*out)[k])) return false;
     return true;
   }
   // "name" (mesh units) or "name_rel" (× bbox diagonal); `found` tells whether either was given.
-  bool length(const Json& obj, const std::string& name, const std::string& where, double* out, bool* found) {
+  bool length(const EditSpecJson& obj, const std::string& name, const std::string& where, double* out, bool* found) {
     *found = false;
     if (obj.contains(name)) {
       *found = true;
@@ -62,7 +62,7 @@ struct Parser {
     return true;
   }
 
-  bool selection(const Json& j, const std::string& where, std::vector<int>* out) {
+  bool selection(const EditSpecJson& j, const std::string& where, std::vector<int>* out) {
     VertexSelection sel;
     if (j.is_array()) {
       for (size_t k = 0; k < j.size(); ++k) {
@@ -72,7 +72,7 @@ struct Parser {
       }
     } else if (j.is_object()) {
       if (!check_keys(j, {"indices", "spheres", "boxes", "rings", "disks", "slabs"}, where)) return false;
-      auto list = [&](const char* key) -> const Json* {
+      auto list = [&](const char* key) -> const EditSpecJson* {
         if (!j.contains(key)) return nullptr;
         if (!j[key].is_array()) {
           fail(StatusCode::ParseError, where + "." + key + " must be an array");
@@ -81,9 +81,9 @@ struct Parser {
         return &j[key];
       };
       if (j.contains("indices") && !selection(j["indices"], where + ".indices", &sel.indices)) return false;
-      if (const Json* a = list("spheres"))
+      if (const EditSpecJson* a = list("spheres"))
         for (size_t k = 0; k < a->size(); ++k) {
-          const Json& e = (*a)[k];
+          const EditSpecJson& e = (*a)[k];
           const std::string w = where + ".spheres[" + std::to_string(k) + "]";
           if (!e.is_object() || !check_keys(e, {"center", "vertex", "radius", "radius_rel"}, w))
             return fail(StatusCode::ParseError, w + " must be an object with center|vertex and radius|radius_rel");
@@ -105,9 +105,9 @@ struct Parser {
           }
           sel.spheres.push_back(s);
         }
-      if (const Json* a = list("boxes"))
+      if (const EditSpecJson* a = list("boxes"))
         for (size_t k = 0; k < a->size(); ++k) {
-          const Json& e = (*a)[k];
+          const EditSpecJson& e = (*a)[k];
           const std::string w = where + ".boxes[" + std::to_string(k) + "]";
           if (!e.is_object() || !check_keys(e, {"min", "max"}, w)) return fail(StatusCode::ParseError, w + " must be {min, max}");
           VertexSelection::Box b;
@@ -115,9 +115,9 @@ struct Parser {
           if (!vec3(e["min"], w + ".min", &b.min) || !vec3(e["max"], w + ".max", &b.max)) return false;
           sel.boxes.push_back(b);
         }
-      if (const Json* a = list("rings"))
+      if (const EditSpecJson* a = list("rings"))
         for (size_t k = 0; k < a->size(); ++k) {
-          const Json& e = (*a)[k];
+          const EditSpecJson& e = (*a)[k];
           const std::string w = where + ".rings[" + std::to_string(k) + "]";
           if (!e.is_object() || !check_keys(e, {"vertex", "k"}, w) || !e.contains("vertex"))
             return fail(StatusCode::ParseError, w + " must be {vertex, k}");
@@ -126,9 +126,9 @@ struct Parser {
           if (e.contains("k") && !integer(e["k"], w + ".k", &r.k)) return false;
           sel.rings.push_back(r);
         }
-      if (const Json* a = list("disks"))
+      if (const EditSpecJson* a = list("disks"))
         for (size_t k = 0; k < a->size(); ++k) {
-          const Json& e = (*a)[k];
+          const EditSpecJson& e = (*a)[k];
           const std::string w = where + ".disks[" + std::to_string(k) + "]";
           if (!e.is_object() || !check_keys(e, {"vertex", "radius", "radius_rel"}, w) || !e.contains("vertex"))
             return fail(StatusCode::ParseError, w + " must be {vertex, radius|radius_rel}");
@@ -139,9 +139,9 @@ struct Parser {
           if (!found) return fail(StatusCode::ParseError, w + " needs radius or radius_rel");
           sel.disks.push_back(d);
         }
-      if (const Json* a = list("slabs"))
+      if (const EditSpecJson* a = list("slabs"))
         for (size_t k = 0; k < a->size(); ++k) {
-          const Json& e = (*a)[k];
+          const EditSpecJson& e = (*a)[k];
           const std::string w = where + ".slabs[" + std::to_string(k) + "]";
           if (!e.is_object() || !check_keys(e, {"axis", "from", "to"}, w))
             return fail(StatusCode::ParseError, w + " must be {axis, from, to}");
@@ -165,9 +165,9 @@ struct Parser {
     return true;
   }
 
-  bool transform(const Json& j, const std::string& where, const std::vector<int>& handle, HandleTransform* out) {
+  bool transform(const EditSpecJson& j, const std::string& where, const std::vector<int>& handle, HandleTransform* out) {
     if (j.contains("matrix")) {
-      const Json& m = j["matrix"];
+      const EditSpecJson& m = j["matrix"];
       if (!m.is_array() || m.size() != 16)
         return fail(StatusCode::ParseError, where + ".matrix must be 16 numbers (column-major 4x4)");
       double a[16];
@@ -189,7 +189,7 @@ struct Parser {
       t *= diag;
     }
     if (j.contains("rotate")) {
-      const Json& r = j["rotate"];
+      const EditSpecJson& r = j["rotate"];
       const std::string w = where + ".rotate";
       if (!r.is_object() || !check_keys(r, {"axis", "degrees", "radians"}, w))
         return fail(StatusCode::ParseError, w + " must be {axis, degrees|radians}");
@@ -220,7 +220,7 @@ struct Parser {
   }
 };
 
-const std::set<std::string>& transform_keys() {
+const std::set<std::string>& edit_spec_transform_keys() {
   static const std::set<std::string> k = {"translate", "translate_rel", "rotate", "pivot", "scale", "matrix"};
   return k;
 }
@@ -231,8 +231,8 @@ using namespace edit_spec_detail;
 
 EditSpecResult parse_edit_spec(const std::string& json_text, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   EditSpecResult out;
-  Parser p{V, F, bounding_box_diagonal(V), {}};
-  const Json j = Json::parse(json_text, nullptr, /*allow_exceptions=*/false);
+  EditSpecParser p{V, F, bounding_box_diagonal(V), {}};
+  const EditSpecJson j = EditSpecJson::parse(json_text, nullptr, /*allow_exceptions=*/false);
   if (j.is_discarded()) {
     out.status = Status::error(StatusCode::ParseError, "edit spec is not valid JSON");
     return out;
@@ -263,10 +263,10 @@ EditSpecResult parse_edit_spec(const std::string& json_text, const Eigen::Matrix
       out.status = Status::error(StatusCode::InvalidArgument, "the edit spec needs a non-empty \"handles\" array");
       return out;
     }
-    const Json& hs = j["handles"];
+    const EditSpecJson& hs = j["handles"];
     for (size_t h = 0; h < hs.size(); ++h) {
       const std::string w = "handles[" + std::to_string(h) + "]";
-      std::set<std::string> keys = transform_keys();
+      std::set<std::string> keys = edit_spec_transform_keys();
       keys.insert({"select", "name"});
       if (!hs[h].is_object() || !p.check_keys(hs[h], keys, w) || !hs[h].contains("select")) {
         out.status = p.status.ok() ? Status::error(StatusCode::ParseError, w + " must be an object with \"select\"") : p.status;
@@ -290,7 +290,7 @@ EditSpecResult parse_edit_spec(const std::string& json_text, const Eigen::Matrix
       spec.transforms.push_back(t);
     }
     if (j.contains("features")) {
-      const Json& f = j["features"];
+      const EditSpecJson& f = j["features"];
       if (!f.is_string() || (f.get<std::string>() != "keep" && f.get<std::string>() != "scale")) {
         out.status = Status::error(StatusCode::ParseError, "features must be \"keep\" or \"scale\"");
         return out;
@@ -298,7 +298,7 @@ EditSpecResult parse_edit_spec(const std::string& json_text, const Eigen::Matrix
       spec.features = f.get<std::string>() == "scale" ? FeatureSize::Scale : FeatureSize::Keep;
     }
     if (j.contains("options")) {
-      const Json& o = j["options"];
+      const EditSpecJson& o = j["options"];
       LaplacianEditOptions& opt = spec.options;
       if (!o.is_object() || !p.check_keys(o, {"method", "weights", "coherence_rings", "coherence_weight",
                                               "condition_threshold", "displacement_scale",
@@ -309,7 +309,7 @@ EditSpecResult parse_edit_spec(const std::string& json_text, const Eigen::Matrix
       }
       auto str = [&](const char* key, const char* a, const char* b, bool* first) {
         if (!o.contains(key)) return true;
-        const Json& v = o[key];
+        const EditSpecJson& v = o[key];
         if (!v.is_string() || (v.get<std::string>() != a && v.get<std::string>() != b))
           return p.fail(StatusCode::ParseError, std::string("options.") + key + " must be \"" + a + "\" or \"" + b + "\"");
         *first = v.get<std::string>() == a;
@@ -348,8 +348,8 @@ HandleTransformsResult parse_handle_transforms(const std::string& json_text, con
                                                const EditRegion& region) {
   HandleTransformsResult out;
   Eigen::MatrixXi noF(0, 3);
-  Parser p{V, noF, bounding_box_diagonal(V), {}};
-  const Json j = Json::parse(json_text, nullptr, false);
+  EditSpecParser p{V, noF, bounding_box_diagonal(V), {}};
+  const EditSpecJson j = EditSpecJson::parse(json_text, nullptr, false);
   if (j.is_discarded() || !j.is_array()) {
     out.status = Status::error(StatusCode::ParseError, "handle transforms must be a JSON array (one object per handle)");
     return out;
@@ -363,7 +363,7 @@ HandleTransformsResult parse_handle_transforms(const std::string& json_text, con
     for (size_t h = 0; h < j.size(); ++h) {
       const std::string w = "transform[" + std::to_string(h) + "]";
       HandleTransform t;
-      if (!j[h].is_object() || !p.check_keys(j[h], transform_keys(), w) || !p.transform(j[h], w, region.handles[h], &t)) {
+      if (!j[h].is_object() || !p.check_keys(j[h], edit_spec_transform_keys(), w) || !p.transform(j[h], w, region.handles[h], &t)) {
         out.status = p.status.ok() ? Status::error(StatusCode::ParseError, w + " must be an object") : p.status;
         return out;
       }

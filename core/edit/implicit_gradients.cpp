@@ -18,25 +18,25 @@ namespace edit_detail {
 // Eigenvalues (ascending) and eigenvectors of the 3x3 spread Σ (p − c)(p − c)ᵀ of a point set.
 // computeDirect is closed-form (fast); its absolute error ~1e-16·λmax is far below what the
 // 2e5 threshold needs (λmin/λmax ≥ 5e-6).
-struct Spread3 {
+struct EditSpread3 {
   Eigen::Vector3d values;
   Eigen::Matrix3d vectors;
 };
 
-Spread3 spread_of(const Eigen::Matrix3d& S) {
+EditSpread3 edit_spread_of(const Eigen::Matrix3d& S) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
   es.computeDirect(S);
   return {es.eigenvalues(), es.eigenvectors()};
 }
 
-double condition_of(const Eigen::Vector3d& ascending) {
+double edit_condition_of(const Eigen::Vector3d& ascending) {
   if (!(ascending[0] > 0) || !std::isfinite(ascending[2])) return std::numeric_limits<double>::infinity();
   return ascending[2] / ascending[0];
 }
 
 // V_i V_iᵀ of Eq. 3/4: columns are the stencil points (center first, then `nbrs`) minus the
 // centroid of the neighbours (v_{i0} in the paper).
-Eigen::Matrix3d gram_of(const Eigen::MatrixXd& P, int center, const std::vector<int>& nbrs) {
+Eigen::Matrix3d edit_gram_of(const Eigen::MatrixXd& P, int center, const std::vector<int>& nbrs) {
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
   for (int j : nbrs) c += P.row(j).transpose();
   c /= static_cast<double>(nbrs.size());
@@ -49,7 +49,7 @@ Eigen::Matrix3d gram_of(const Eigen::MatrixXd& P, int center, const std::vector<
   return G;
 }
 
-Eigen::Matrix3d neighbour_spread(const Eigen::MatrixXd& P, const std::vector<int>& nbrs) {
+Eigen::Matrix3d edit_neighbour_spread(const Eigen::MatrixXd& P, const std::vector<int>& nbrs) {
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
   for (int j : nbrs) c += P.row(j).transpose();
   c /= static_cast<double>(nbrs.size());
@@ -129,16 +129,16 @@ ImplicitGradients implicit_gradients(const Eigen::MatrixXd& V, const Eigen::Matr
     bool changed = false;
     for (size_t c = 0; c < centers.size(); ++c) {
       const int i = centers[c];
-      Spread3 s = spread_of(gram_of(P, i, nbrs[c]));
-      if (condition_of(s.values) <= thr) continue;
+      EditSpread3 s = edit_spread_of(edit_gram_of(P, i, nbrs[c]));
+      if (edit_condition_of(s.values) <= thr) continue;
       if (pass == 0) was_degenerate[c] = 1;
       if (adjacency[i].size() < 3 && !is_widened[c]) {
         widen(c);
         changed = true;
-        s = spread_of(gram_of(P, i, nbrs[c]));
-        if (condition_of(s.values) <= thr) continue;
+        s = edit_spread_of(edit_gram_of(P, i, nbrs[c]));
+        if (edit_condition_of(s.values) <= thr) continue;
       }
-      const Spread3 ns = spread_of(neighbour_spread(P, nbrs[c]));
+      const EditSpread3 ns = edit_spread_of(edit_neighbour_spread(P, nbrs[c]));
       const bool collinear = !(ns.values[1] > ns.values[2] / thr);
       if (collinear) {
         // Displacing i cannot help (only two directions either way): move a neighbouring
@@ -171,8 +171,8 @@ ImplicitGradients implicit_gradients(const Eigen::MatrixXd& V, const Eigen::Matr
   std::vector<Eigen::Vector3d> w;
   for (size_t c = 0; c < centers.size(); ++c) {
     const int i = centers[c];
-    const Eigen::Matrix3d G = gram_of(P, i, nbrs[c]);
-    const double cond = condition_of(spread_of(G).values);
+    const Eigen::Matrix3d G = edit_gram_of(P, i, nbrs[c]);
+    const double cond = edit_condition_of(edit_spread_of(G).values);
     if (!(cond <= 1e12)) {
       out.status = Status::error(StatusCode::InvalidMesh,
                                  "the neighbourhood of vertex " + std::to_string(i) +

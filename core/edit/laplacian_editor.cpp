@@ -4,32 +4,31 @@
 #include <chrono>
 #include <cmath>
 #include <string>
-#include <cstdio>
-#include <cstdlib>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 #include <Eigen/SparseCore>
 
 #include "edit/implicit_gradients.h"
 #include "edit/selection.h"
+#include "edit/shear_removal.h"
 #include "edit/supernodal_cholesky.h"
 #include "linalg/polar.h"
 #include "linalg/spd_solver.h"
 #include "mesh/topology.h"
-#include "mesh/validate.h"
 #include "operators/operators.h"
 
 namespace mm {
 
 namespace edit_detail {
 
-using Sparse = Eigen::SparseMatrix<double>;
-using Trip = Eigen::Triplet<double>;
+using EditSparse = Eigen::SparseMatrix<double>;
+using EditTriplet = Eigen::Triplet<double>;
 
 // Vertices within `k` edges of any seed (multi-source BFS), marked in `mark` (size #V) with the
 // distance; unreached vertices keep -1. Returns them ascending.
-std::vector<int> ring_closure(const std::vector<std::vector<int>>& adj, const std::vector<int>& seeds, int k,
+std::vector<int> edit_ring_closure(const std::vector<std::vector<int>>& adj, const std::vector<int>& seeds, int k,
                               std::vector<int>* dist_out = nullptr) {
   std::vector<int> dist(adj.size(), -1), frontier, next, out;
   for (int s : seeds)
@@ -55,7 +54,7 @@ std::vector<int> ring_closure(const std::vector<std::vector<int>>& adj, const st
 
 // Best-fit similarity linear part (s·R) mapping rest points P to targets Q (Umeyama 1991).
 // Fewer than 3 points, or collinear points, give the identity (no rotation can be read off).
-Eigen::Matrix3d fit_similarity_linear(const Eigen::MatrixXd& P, const Eigen::MatrixXd& Q) {
+Eigen::Matrix3d edit_fit_similarity_linear(const Eigen::MatrixXd& P, const Eigen::MatrixXd& Q) {
   if (P.rows() < 3) return Eigen::Matrix3d::Identity();
   const Eigen::RowVector3d pc = P.colwise().mean(), qc = Q.colwise().mean();
   const Eigen::MatrixXd P0 = P.rowwise() - pc, Q0 = Q.rowwise() - qc;
@@ -73,7 +72,7 @@ Eigen::Matrix3d fit_similarity_linear(const Eigen::MatrixXd& P, const Eigen::Mat
 
 // Non-manifold checks restricted to the faces around the unknowns (exact there: every face of an
 // edge or vertex of an unknown is in `faces`).
-Status check_region_manifold(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const std::vector<int>& faces,
+Status edit_check_region_manifold(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const std::vector<int>& faces,
                              const std::vector<char>& is_unknown) {
   struct HalfEdge {
     int a, b, face;
@@ -157,7 +156,7 @@ Status check_region_manifold(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
 
 
 // Milliseconds since `t0`; resets t0 to now.
-double lap_ms(std::chrono::steady_clock::time_point* t0) {
+double edit_lap_ms(std::chrono::steady_clock::time_point* t0) {
   const auto now = std::chrono::steady_clock::now();
   const double ms = std::chrono::duration<double, std::milli>(now - *t0).count();
   *t0 = now;
@@ -198,15 +197,15 @@ struct LaplacianEditor::Impl {
 
   // Stage 1 (Eq. 7): AᵀA has a 4-ring pattern; the supernodal factor is 3–5× faster there.
   SupernodalCholesky solver1;
-  edit_detail::Sparse Q1;        // nU by nK: the block N_UK of AᵀA
+  edit_detail::EditSparse Q1;        // nU by nK: the block N_UK of AᵀA
   Eigen::MatrixXd G1;            // nU by 3·H: gradient-constraint right-hand side per handle
   Eigen::MatrixXd Phi0;          // nU by 3
   std::vector<Eigen::MatrixXd> Phi;  // per handle nU by 4
   bool have_basis = false;
 
-  // Stage 2 (Eq. 9/10) on the undisplaced mesh.
-  SpdSolver solver2;
-  edit_detail::Sparse D2_UU, D2_UK;  // hard: W_UU, W_UK; soft: row-scaled D rows of unknowns
+  // Stage 2 (Eq. 9/10) on the undisplaced mesh (1-ring pattern; supernodal solves are faster).
+  SupernodalCholesky solver2;
+  edit_detail::EditSparse D2_UU, D2_UK;  // hard: W_UU, W_UK; soft: row-scaled D rows of unknowns
   Eigen::MatrixXd LC;                // nU by 3: (W V)_i of the unknowns (rest Laplacian coordinates)
   Eigen::VectorXd row_scale2;        // soft mode: per-unknown row scale of D (2h/A_i or 1/(h·deg))
 
@@ -258,9 +257,19 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     return Status::error(StatusCode::InvalidArgument,
                          "edit options out of range (weights must be finite and ≥ 0, coherence_weight > 0, "
                          "condition_threshold > 1, displacement_scale > 0)");
-  auto t_check = std::chrono::steady_clock::now();
-  if (Status s = check_mesh(Vin, F); !s.ok()) return s;
-  if (std::getenv("MM_EDIT_DEBUG")) std::fprintf(stderr, "  [edit] check_mesh %.1f ms\n", lap_ms(&t_check));
+  // Only the defects no method can work with are checked here (cheaply, O(#V + #F)); the
+  // manifold checks below are restricted to the edited region.
+  if (Vin.rows() == 0 || F.rows() == 0 || Vin.cols() != 3)
+    return Status::error(StatusCode::InvalidMesh, "mesh is empty (no vertices or no faces)");
+  for (int v = 0; v < Vin.rows(); ++v)
+    if (!Vin.row(v).allFinite())
+      return Status::error(StatusCode::InvalidMesh, "vertex " + std::to_string(v) + " has a non-finite coordinate");
+  for (int f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c)
+      if (F(f, c) < 0 || F(f, c) >= Vin.rows())
+        return Status::error(StatusCode::InvalidMesh, "face " + std::to_string(f) + " has vertex index " +
+                                                          std::to_string(F(f, c)) + ", out of range (mesh has " +
+                                                          std::to_string(Vin.rows()) + " vertices)");
   V = Vin;
   const int n = static_cast<int>(V.rows());
   num_handles = static_cast<int>(region.handles.size());
@@ -314,19 +323,12 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     return Status::error(StatusCode::InvalidArgument,
                          "the region of interest has no free vertex (every ROI vertex is a handle or fixed)");
 
-  auto dbg = std::chrono::steady_clock::now();
-  const bool dbg_on = std::getenv("MM_EDIT_DEBUG") != nullptr;
-  auto dbg_lap = [&](const char* what) {
-    if (dbg_on) std::fprintf(stderr, "  [edit] %s %.1f ms\n", what, lap_ms(&dbg));
-  };
   const auto adj = vertex_adjacency(F, n);
-  dbg_lap("adjacency");
   // Faces around the unknowns: complete 1-rings for their Laplacian rows.
   std::vector<int> faces;
   for (int f = 0; f < F.rows(); ++f)
     if (unknown[F(f, 0)] || unknown[F(f, 1)] || unknown[F(f, 2)]) faces.push_back(f);
-  if (Status s = check_region_manifold(V, F, faces, unknown); !s.ok()) return s;
-  dbg_lap("manifold");
+  if (Status s = edit_check_region_manifold(V, F, faces, unknown); !s.ok()) return s;
   for (int v : U)
     if (adj[v].empty())
       return Status::error(StatusCode::InvalidMesh, "vertex " + std::to_string(v) + " of the region of interest is isolated");
@@ -360,7 +362,6 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
                                  " are not connected to any handle or fixed vertex; add a constraint there or shrink the ROI");
     }
   }
-  dbg_lap("components");
   if (!progress.update("edit: stencils", 0.0)) return cancelled_status("edit: stencils");
   auto clock = std::chrono::steady_clock::now();
 
@@ -382,7 +383,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
   if (implicit) {
     // Candidates: every center whose gradient may involve an unknown (stencils reach at most two
     // rings when widened) plus their coherence partners.
-    const std::vector<int> candidates = ring_closure(adj, U, r + 2);
+    const std::vector<int> candidates = edit_ring_closure(adj, U, r + 2);
     ImplicitGradientOptions gopt;
     gopt.condition_threshold = opt.condition_threshold;
     gopt.displacement_scale = opt.displacement_scale;
@@ -393,7 +394,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     Vd = V;
   }
   if (!progress.update("edit: stencils", 0.05)) return cancelled_status("edit: stencils");
-  stats.stencil_ms = lap_ms(&clock);
+  stats.stencil_ms = edit_lap_ms(&clock);
 
   // ---- local numbering
   std::vector<int> g2l(n, -1);
@@ -416,7 +417,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
         }
     for (size_t c = 0; c < grads.centers.size(); ++c)
       if (is_active[c]) active_centers.push_back(grads.centers[c]);
-    pair_centers = ring_closure(adj, active_centers, r);
+    pair_centers = edit_ring_closure(adj, active_centers, r);
     for (int v : pair_centers) {
       const int c = center_index[v];
       assert(c >= 0 && "pair center without a stencil");
@@ -461,23 +462,22 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
       if (disp[l2g[l]]) displaced_unknowns.push_back(l);
   }
 
-  dbg_lap("numbering");
   // ---- Laplacian operators on the face set. Stage 1 uses the displaced rest mesh, stage 2 the
   // undisplaced one. D_i = −(2/A_i)·W_i (cotangent, paper Sec. 2) or D_i = −L_i/deg_i (uniform).
   Eigen::MatrixXi Fsub(faces.size(), 3);
   for (size_t k = 0; k < faces.size(); ++k) Fsub.row(static_cast<Eigen::Index>(k)) = F.row(faces[k]);
   const bool cot = opt.weights == LaplacianWeights::Cotangent;
-  auto laplacian_rows = [&](const Eigen::MatrixXd& P, Sparse* Wout, Eigen::VectorXd* dscale) {
+  auto laplacian_rows = [&](const Eigen::MatrixXd& P, EditSparse* Wout, Eigen::VectorXd* dscale) {
     // Rows of the unknowns (as columns of the symmetric matrix) in local numbering, plus the
     // factor turning W_i into the paper's D_i.
-    const Sparse W = cot ? cotan_stiffness(P, Fsub) : uniform_laplacian(Fsub, n);
+    const EditSparse W = cot ? cotan_stiffness(P, Fsub) : uniform_laplacian(Fsub, n);
     Eigen::VectorXd area;
     if (cot) area = mass_diagonal(P, Fsub, MassType::Voronoi);
-    std::vector<Trip> t;
+    std::vector<EditTriplet> t;
     dscale->resize(nU);
     for (int l = 0; l < nU; ++l) {
       const int v = l2g[l];
-      for (Sparse::InnerIterator it(W, v); it; ++it) t.emplace_back(l, g2l[it.row()], it.value());
+      for (EditSparse::InnerIterator it(W, v); it; ++it) t.emplace_back(l, g2l[it.row()], it.value());
       (*dscale)[l] = cot ? -2.0 / area[v] : -1.0 / static_cast<double>(adj[v].size());
     }
     Wout->resize(nU, nL);
@@ -486,7 +486,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
 
   // Stage 2 operator (undisplaced mesh): W_UU, W_UK and rest Laplacian coordinates.
   {
-    Sparse W2;
+    EditSparse W2;
     Eigen::VectorXd ds2;
     laplacian_rows(V, &W2, &ds2);
     Eigen::MatrixXd Xrest(nL, 3);
@@ -500,29 +500,28 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
       row_scale2 = (cot ? h : 1.0 / h) * ds2;
       for (int l = 0; l < nU; ++l)
         if (!has_row[l]) row_scale2[l] = 0;
-      const Sparse Ds = row_scale2.asDiagonal() * W2;
+      const EditSparse Ds = row_scale2.asDiagonal() * W2;
       D2_UU = Ds.leftCols(nU);
       D2_UK = Ds.rightCols(nL - nU);
     }
-    dbg_lap("poisson assembly");
     if (!progress.update("edit: poisson factor", 0.06)) return cancelled_status("edit: poisson factor");
-    Sparse N2;
+    EditSparse N2;
     if (!soft_mode) {
       N2 = D2_UU;
     } else {
-      N2 = Sparse(D2_UU.transpose()) * D2_UU;
+      N2 = EditSparse(D2_UU.transpose()) * D2_UU;
       for (int l = 0; l < nU; ++l)
         if (soft[l] > 0) N2.coeffRef(l, l) += soft[l];
     }
     if (Status s = solver2.factor(N2); !s.ok())
       return Status::error(s.code, "Poisson system (Eq. 9/10): " + s.message);
-    stats.poisson_ms = lap_ms(&clock);
+    stats.poisson_ms = edit_lap_ms(&clock);
   }
   if (!progress.update("edit: assembling", 0.1)) return cancelled_status("edit: assembling");
 
   if (implicit) {
     // ---- stage 1 normal equations N = AᵀA over local numbering (same for x, y, z).
-    Sparse W1;
+    EditSparse W1;
     Eigen::VectorXd ds1;
     laplacian_rows(Vd, &W1, &ds1);
     Eigen::MatrixXd Xd(nL, 3);
@@ -531,7 +530,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     // displaced mesh and s = h (cotangent, D ~ 1/length²) or 1/h (uniform, D ~ 1).
     const double lscale = cot ? h : 1.0 / h;
     const Eigen::MatrixXd W1X = W1 * Xd;
-    std::vector<Trip> t;
+    std::vector<EditTriplet> t;
     for (int l = 0; l < nU; ++l) {
       if (!has_row[l]) continue;
       const Eigen::Vector3d delta = ds1[l] * W1X.row(l).transpose();
@@ -539,7 +538,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
       for (int e = grads.offsets[c]; e < grads.offsets[c + 1]; ++e)
         t.emplace_back(l, stencil_local[e], -lscale * grads.weights.row(e).dot(delta));
     }
-    Sparse E(nU, nL);
+    EditSparse E(nU, nL);
     E.setFromTriplets(t.begin(), t.end());
     {
       Eigen::VectorXd s = lscale * ds1;
@@ -547,7 +546,6 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
         if (!has_row[l]) s[l] = 0;
       E += s.asDiagonal() * W1;
     }
-    dbg_lap("E_L rows");
     if (!progress.update("edit: assembling", 0.15)) return cancelled_status("edit: assembling");
 
     // E_R (Eq. 6) over SF = pairs within r rings, at least one of them active. With S_p the
@@ -583,7 +581,6 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
       }
     }
     stats.coherence_pairs = static_cast<int>(partners.size() / 2);
-    dbg_lap("pairs");
     // Y_a for active centers, as sparse lists (local vertex, 3-vector).
     std::vector<double> acc3(3 * static_cast<size_t>(nL), 0.0);
     std::vector<int> mark(nL, -1), touched;
@@ -613,7 +610,6 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
       }
       y_ptr[p + 1] = static_cast<int>(y_idx.size());
     }
-    dbg_lap("Y");
     // Reverse index: for each unknown, the (pair center, stencil entry) pairs that contain it.
     std::vector<int> rev_ptr(nU + 1, 0), rev_center, rev_entry;
     for (int p = 0; p < nP; ++p) {
@@ -650,9 +646,9 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
             for (int k = 0; k < 3; ++k) G1(stencil_local[e], 3 * gid[v] + k) += wg * grads.weights(e, k);
       }
     const Eigen::SparseMatrix<double, Eigen::RowMajor> Erow = E;  // rows of E
-    const Sparse& Ecol = E;                                        // columns of E
+    const EditSparse& Ecol = E;                                        // columns of E
     // Columns of N = AᵀA for the unknowns: lower part of N_UU and the block N_UK (as rows).
-    Sparse NUU(nU, nU);
+    EditSparse NUU(nU, nU);
     Eigen::SparseMatrix<double, Eigen::RowMajor> QR(nU, nL - nU);
     NUU.reserve(static_cast<Eigen::Index>(nU) * 40);
     QR.reserve(static_cast<Eigen::Index>(nU) * 8);
@@ -679,7 +675,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
             add(stencil_local[f], wg * (s0 * grads.weights(f, 0) + s1 * grads.weights(f, 1) + s2 * grads.weights(f, 2)));
         }
       }
-      for (Sparse::InnerIterator er(Ecol, i); er; ++er)
+      for (EditSparse::InnerIterator er(Ecol, i); er; ++er)
         for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator ej(Erow, er.row()); ej; ++ej)
           add(static_cast<int>(ej.col()), er.value() * ej.value());
       if (soft[i] > 0) add(i, soft[i]);
@@ -694,17 +690,15 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     NUU.finalize();
     QR.finalize();
     Q1 = QR;
-    dbg_lap("columns");
 
     stats.system_nonzeros = static_cast<long>(NUU.nonZeros());
-    dbg_lap("split");
-    stats.assembly_ms = lap_ms(&clock);
+    stats.assembly_ms = edit_lap_ms(&clock);
     if (!progress.update("edit: factor", 0.35)) return cancelled_status("edit: factor");
     if (Status s = solver1.factor(NUU, progress.sub(0.35, 0.9)); !s.ok())
       return Status::error(s.code, "implicit editing system (Eq. 7): " + s.message +
                                        ". The handles may not determine a rotation: constrain at least 3 "
                                        "non-collinear vertices");
-    stats.factor_ms = lap_ms(&clock);
+    stats.factor_ms = edit_lap_ms(&clock);
     stats.factor_nonzeros = solver1.factor_entries();
     if (!progress.update("edit: factor", 0.9)) return cancelled_status("edit: factor");
 
@@ -743,7 +737,7 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
       Phi.resize(num_handles);
       for (int hh = 0; hh < num_handles; ++hh) Phi[hh] = X.block(0, 3 + 4 * hh, nU, 4);
       have_basis = true;
-      stats.basis_ms = lap_ms(&clock);
+      stats.basis_ms = edit_lap_ms(&clock);
     }
   }
   if (!progress.update("edit: done", 1.0)) return cancelled_status("edit: done");
@@ -813,10 +807,10 @@ EditResult LaplacianEditor::Impl::solve_stage2(bool use_rotations, FeatureSize m
     // Sec. 4: M_i = U W Vᵀ → R_i = U Vᵀ, s_i = sqrt((λ1² + λ2² + λ3²)/3); b_i = R_i S_i δ_i
     // (Eq. 10) or R_i δ_i (Eq. 9), with δ_i = (W v)_i up to the row factor that cancels.
     for (int l = 0; l < nU; ++l) {
-      const Polar3 p = polar_decomposition(gradient_local(l));
+      const Eigen::Matrix3d M = gradient_local(l);
       double s = 1.0;
-      if (mode == FeatureSize::Scale) s = std::sqrt(p.singular_values.squaredNorm() / 3.0);
-      b.row(l) = (s * (p.R * LC.row(l).transpose())).transpose();
+      if (mode == FeatureSize::Scale) s = std::sqrt(M.squaredNorm() / 3.0);  // Σσ² = ||M||²_F
+      b.row(l) = (s * (rotation_part(M) * LC.row(l).transpose())).transpose();
     }
   } else {
     b = LC;  // naive Laplacian editing: unrotated Laplacian coordinates
@@ -920,7 +914,7 @@ EditResult LaplacianEditor::drag_positions(const Eigen::MatrixXd& targets) {
     }
     if (!Q.allFinite())
       return edit_error(StatusCode::InvalidArgument, "handle " + std::to_string(h) + " targets have non-finite entries");
-    linear[h] = fit_similarity_linear(P, Q);
+    linear[h] = edit_fit_similarity_linear(P, Q);
   }
   const int nK = m.nL - m.nU;
   m.known.resize(nK, 3);

@@ -4,9 +4,6 @@
 #include <cmath>
 #include <limits>
 #include <string>
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
 
 #include <Eigen/Cholesky>
 #include <Eigen/OrderingMethods>
@@ -15,30 +12,46 @@ namespace mm {
 
 namespace supernodal_detail {
 
-using Sparse = Eigen::SparseMatrix<double>;
+using SnSparse = Eigen::SparseMatrix<double>;
 
-// Lower triangle of P A Pᵀ, where row/column i of A becomes p[i].
-Sparse permuted_lower(const Sparse& A, const std::vector<int>& p) {
-  std::vector<Eigen::Triplet<double>> t;
-  t.reserve(static_cast<size_t>(A.nonZeros()));
-  for (int j = 0; j < A.outerSize(); ++j)
-    for (Sparse::InnerIterator it(A, j); it; ++it) {
+// Lower triangle of P A Pᵀ, where row/column i of A becomes p[i]. Counting sort by column, then
+// a small sort per column: O(nnz) instead of sorting triplets.
+SnSparse sn_permuted_lower(const SnSparse& A, const std::vector<int>& p) {
+  const int n = static_cast<int>(A.cols());
+  std::vector<int> count(n + 1, 0);
+  for (int j = 0; j < n; ++j)
+    for (SnSparse::InnerIterator it(A, j); it; ++it)
+      if (it.row() >= j) ++count[std::min(p[it.row()], p[j]) + 1];
+  for (int j = 0; j < n; ++j) count[j + 1] += count[j];
+  SnSparse C(n, n);
+  C.resizeNonZeros(count[n]);
+  std::vector<int> fill(count.begin(), count.end() - 1);
+  std::vector<std::pair<int, double>> entries(static_cast<size_t>(count[n]));
+  for (int j = 0; j < n; ++j)
+    for (SnSparse::InnerIterator it(A, j); it; ++it) {
       if (it.row() < j) continue;  // only the lower triangle is read
-      int a = p[it.row()], b = p[j];
-      if (a < b) std::swap(a, b);
-      t.emplace_back(a, b, it.value());
+      const int a = p[it.row()], b = p[j];
+      entries[fill[std::min(a, b)]++] = {std::max(a, b), it.value()};
     }
-  Sparse C(A.rows(), A.cols());
-  C.setFromTriplets(t.begin(), t.end());
+  for (int j = 0; j < n; ++j) {
+    std::sort(entries.begin() + count[j], entries.begin() + count[j + 1]);
+    C.outerIndexPtr()[j] = count[j];
+  }
+  C.outerIndexPtr()[n] = count[n];
+  // Duplicates cannot occur (A has one entry per position), so the pattern maps one to one.
+  for (int k = 0; k < count[n]; ++k) {
+    C.innerIndexPtr()[k] = entries[k].first;
+    C.valuePtr()[k] = entries[k].second;
+  }
   return C;
 }
 
 // Elimination tree (Liu's algorithm with path compression) from the upper triangle U (CSC).
-std::vector<int> elimination_tree(const Sparse& U) {
+std::vector<int> sn_elimination_tree(const SnSparse& U) {
   const int n = static_cast<int>(U.cols());
   std::vector<int> parent(n, -1), ancestor(n, -1);
   for (int k = 0; k < n; ++k)
-    for (Sparse::InnerIterator it(U, k); it; ++it) {
+    for (SnSparse::InnerIterator it(U, k); it; ++it) {
       for (int i = static_cast<int>(it.row()); i != -1 && i < k;) {
         const int next = ancestor[i];
         ancestor[i] = k;
@@ -50,7 +63,7 @@ std::vector<int> elimination_tree(const Sparse& U) {
 }
 
 // Postorder of a forest: order[k] = the node visited k-th (children in increasing order).
-std::vector<int> postorder(const std::vector<int>& parent) {
+std::vector<int> sn_postorder(const std::vector<int>& parent) {
   const int n = static_cast<int>(parent.size());
   std::vector<int> head(n, -1), next(n, -1), order;
   order.reserve(n);
@@ -81,7 +94,7 @@ std::vector<int> postorder(const std::vector<int>& parent) {
 // Whether merging keeps the block dense enough (CHOLMOD's default relaxation: always for ≤ 4
 // columns, then ≤ 80% / 10% / 5% explicit zeros for ≤ 16 / ≤ 48 / more columns). Merged
 // supernodes trade a few stored zeros for much larger dense kernels.
-bool relax_merge(int ncols, double zero_fraction) {
+bool sn_relax_merge(int ncols, double zero_fraction) {
   if (ncols <= 4) return true;
   if (ncols <= 16) return zero_fraction < 0.8;
   if (ncols <= 48) return zero_fraction < 0.1;
@@ -108,40 +121,32 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     return Status::success();
   }
 
-  auto dbg_t = std::chrono::steady_clock::now();
-  const bool dbg = std::getenv("MM_EDIT_DEBUG") != nullptr;
-  auto dbg_lap = [&](const char* what) {
-    const auto now = std::chrono::steady_clock::now();
-    if (dbg) std::fprintf(stderr, "  [sn] %s %.1f ms\n", what, std::chrono::duration<double, std::milli>(now - dbg_t).count());
-    dbg_t = now;
-  };
-  // ---- ordering: AMD, then a postorder of the elimination tree (same fill, contiguous subtrees).
+  // ---- ordering: AMD, then a sn_postorder of the elimination tree (same fill, contiguous subtrees).
   {
-    const Sparse full = A.selfadjointView<Eigen::Lower>();
     Eigen::AMDOrdering<int> amd;
     Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> Pinv;
-    amd(full, Pinv);
+    // The self-adjoint overload symmetrises once (the plain one would form A + Aᵀ again).
+    amd(A.selfadjointView<Eigen::Lower>(), Pinv);
     const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P = Pinv.inverse();
     for (int i = 0; i < n; ++i) perm_[i] = P.indices()[i];
   }
-  Sparse C = permuted_lower(A, perm_);
+  SnSparse C = sn_permuted_lower(A, perm_);
   {
-    const std::vector<int> order = postorder(elimination_tree(Sparse(C.transpose())));
+    const std::vector<int> order = sn_postorder(sn_elimination_tree(SnSparse(C.transpose())));
     std::vector<int> q(n);
     for (int k = 0; k < n; ++k) q[order[k]] = k;
     for (int i = 0; i < n; ++i) perm_[i] = q[perm_[i]];
-    C = permuted_lower(A, perm_);
+    C = sn_permuted_lower(A, perm_);
   }
-  const Sparse U = C.transpose();
-  const std::vector<int> parent = elimination_tree(U);
-  dbg_lap("ordering+postorder+etree");
+  const SnSparse U = C.transpose();
+  const std::vector<int> parent = sn_elimination_tree(U);
   if (!progress.update("factor: analysis", 0.5)) return cancelled_status("factor");
 
   // ---- column counts of L (off-diagonal) by row subtrees: O(nnz(L)).
   std::vector<int> cc(n, 0), mark(n, -1), nchild(n, 0);
   for (int k = 0; k < n; ++k) {
     mark[k] = k;
-    for (Sparse::InnerIterator it(U, k); it; ++it)
+    for (SnSparse::InnerIterator it(U, k); it; ++it)
       for (int j = static_cast<int>(it.row()); j < k && mark[j] != k; j = parent[j]) {
         ++cc[j];
         mark[j] = k;
@@ -164,7 +169,7 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
       const long ncols = pl - gf, below = cc[pl - 1];
       const double dense = 0.5 * ncols * (ncols + 1) + static_cast<double>(ncols) * below;
       const double actual = static_cast<double>(col_nnz_prefix[pl] - col_nnz_prefix[gf]);
-      if (relax_merge(static_cast<int>(ncols), (dense - actual) / dense)) {
+      if (sn_relax_merge(static_cast<int>(ncols), (dense - actual) / dense)) {
         gl = pl;
         merged = true;
       }
@@ -194,7 +199,7 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     const int f = start_[s], l = start_[s + 1];
     list.clear();
     for (int j = f; j < l; ++j)
-      for (Sparse::InnerIterator it(C, j); it; ++it) {
+      for (SnSparse::InnerIterator it(C, j); it; ++it) {
         const int i = static_cast<int>(it.row());
         if (i >= l && mark[i] != s) {
           mark[i] = s;
@@ -217,11 +222,9 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     total_flops += static_cast<double>(ncols) * m * m;
   }
   values_.assign(static_cast<size_t>(value_ptr_.back()), 0.0);
-  dbg_lap("symbolic");
-  if (dbg) std::fprintf(stderr, "  [sn] n %d supernodes %d (fundamental %zu) entries %ld flops %.2f G\n", n, ns, fundamental.size() - 1, (long)values_.size(), total_flops / 1e9);
   if (!progress.update("factor: analysis", 1.0)) return cancelled_status("factor");
 
-  // ---- numeric multifrontal factorization in postorder; update matrices on a stack.
+  // ---- numeric multifrontal factorization in sn_postorder; update matrices on a stack.
   std::vector<int> relpos(n, -1);
   std::vector<std::vector<double>> stack;
   std::vector<double> front;
@@ -235,7 +238,7 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     front.assign(static_cast<size_t>(m) * m, 0.0);
     Eigen::Map<Eigen::MatrixXd> Fm(front.data(), m, m);
     for (int j = f; j < l; ++j)
-      for (Sparse::InnerIterator it(C, j); it; ++it) Fm(relpos[it.row()], j - f) += it.value();
+      for (SnSparse::InnerIterator it(C, j); it; ++it) Fm(relpos[it.row()], j - f) += it.value();
     // Extend-add of the children's update matrices (the last |children| entries of the stack).
     for (size_t c = children[s].size(); c-- > 0;) {
       const int child = children[s][c];
@@ -276,7 +279,6 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
       if (!progress.update("factor", done_flops / total_flops)) return cancelled_status("factor");
     }
   }
-  dbg_lap("numeric");
   // Relative pivot check, as SpdSolver does: a tiny pivot means a numerically singular matrix.
   double max_d = 0, min_d = std::numeric_limits<double>::infinity();
   for (int s = 0; s < ns; ++s) {

@@ -208,6 +208,15 @@ Status write_morph_animation(const Asset& target, const AnimatedCharacter* tc, c
     prim.mode = TINYGLTF_MODE_TRIANGLES;
     prim.indices = gltf_append_index_accessor(&m, 0, F);
     prim.attributes["POSITION"] = gltf_append_float_accessor(&m, 0, V_rest, true);
+    // A plain dielectric material: without one, viewers apply glTF's default (metallic 1),
+    // which renders black in three.js unless the scene has an environment map.
+    tinygltf::Material material;
+    material.name = "target";
+    material.pbrMetallicRoughness.metallicFactor = 0.0;
+    material.pbrMetallicRoughness.roughnessFactor = 0.8;
+    material.pbrMetallicRoughness.baseColorFactor = {0.8, 0.8, 0.8, 1.0};
+    m.materials.push_back(material);
+    prim.material = 0;
     tinygltf::Mesh mesh;
     mesh.name = "target";
     mesh.primitives.push_back(prim);

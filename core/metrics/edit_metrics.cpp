@@ -17,7 +17,7 @@ namespace edit_metrics_detail {
 
 // Umeyama fit of a similarity between two point sets (rows). Returns the rotation and writes the
 // residual sum of squares.
-Eigen::Matrix3d umeyama_rotation(const Eigen::MatrixXd& P, const Eigen::MatrixXd& Q, double* residual2,
+Eigen::Matrix3d edit_metrics_umeyama(const Eigen::MatrixXd& P, const Eigen::MatrixXd& Q, double* residual2,
                                  double* q_spread2) {
   const Eigen::RowVector3d pc = P.colwise().mean(), qc = Q.colwise().mean();
   const Eigen::MatrixXd P0 = P.rowwise() - pc, Q0 = Q.rowwise() - qc;
@@ -32,7 +32,7 @@ Eigen::Matrix3d umeyama_rotation(const Eigen::MatrixXd& P, const Eigen::MatrixXd
   return svd.matrixU() * D * svd.matrixV().transpose();
 }
 
-Eigen::MatrixXd ring_points(const Eigen::MatrixXd& X, int i, const std::vector<int>& ring) {
+Eigen::MatrixXd edit_metrics_ring_points(const Eigen::MatrixXd& X, int i, const std::vector<int>& ring) {
   Eigen::MatrixXd P(ring.size() + 1, 3);
   P.row(0) = X.row(i);
   for (size_t k = 0; k < ring.size(); ++k) P.row(static_cast<Eigen::Index>(k) + 1) = X.row(ring[k]);
@@ -50,7 +50,7 @@ Eigen::VectorXd local_rigidity_error(const Eigen::MatrixXd& V0, const Eigen::Mat
   for (int i = 0; i < n; ++i) {
     if (adj[i].size() < 2) continue;
     double res2 = 0, q2 = 0;
-    umeyama_rotation(ring_points(V0, i, adj[i]), ring_points(V1, i, adj[i]), &res2, &q2);
+    edit_metrics_umeyama(edit_metrics_ring_points(V0, i, adj[i]), edit_metrics_ring_points(V1, i, adj[i]), &res2, &q2);
     if (q2 > 0) err[i] = std::sqrt(res2 / q2);
   }
   return err;
@@ -181,7 +181,7 @@ std::vector<int> inverted_faces(const Eigen::MatrixXd& V0, const Eigen::MatrixXd
       Q.row(static_cast<Eigen::Index>(k)) = V1.row(pts[k]);
     }
     if (N0.row(f).squaredNorm() == 0) continue;  // degenerate at rest: orientation undefined
-    const Eigen::Matrix3d R = umeyama_rotation(P, Q, nullptr, nullptr);
+    const Eigen::Matrix3d R = edit_metrics_umeyama(P, Q, nullptr, nullptr);
     const Eigen::Vector3d n0 = R * N0.row(f).transpose();
     if (N1.row(f).squaredNorm() == 0 || N1.row(f).dot(n0) <= 0) out.push_back(f);
   }
