@@ -15,7 +15,6 @@
 #include "edit/shear_removal.h"
 #include "edit/supernodal_cholesky.h"
 #include "linalg/polar.h"
-#include "linalg/spd_solver.h"
 #include "mesh/topology.h"
 #include "operators/operators.h"
 
@@ -154,7 +153,6 @@ Status edit_check_region_manifold(const Eigen::MatrixXd& V, const Eigen::MatrixX
   return Status::success();
 }
 
-
 // Milliseconds since `t0`; resets t0 to now.
 double edit_lap_ms(std::chrono::steady_clock::time_point* t0) {
   const auto now = std::chrono::steady_clock::now();
@@ -195,7 +193,8 @@ struct LaplacianEditor::Impl {
   std::vector<int> stencil_local;  // grads.stencil mapped to local numbering (-1 outside)
   std::vector<int> displaced_unknowns;  // local unknowns displaced by Eq. 8
 
-  // Stage 1 (Eq. 7): AᵀA has a 4-ring pattern; the supernodal factor is 3–5× faster there.
+  // Stage 1 (Eq. 7): AᵀA has a 4-ring pattern; the supernodal factor is 2.5–4× faster there
+  // than Eigen::SimplicialLDLT (measured at 14.6k and 52k vertices).
   SupernodalCholesky solver1;
   edit_detail::EditSparse Q1;        // nU by nK: the block N_UK of AᵀA
   Eigen::MatrixXd G1;            // nU by 3·H: gradient-constraint right-hand side per handle

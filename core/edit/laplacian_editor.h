@@ -97,7 +97,9 @@ struct LaplacianEditOptions {
   double gradient_constraint_weight = 0.0;
   // 0 = hard position constraints, eliminated from the system (paper). > 0 = soft constraints on
   // handle and fixed vertices with this weight relative to E_L (dimensionless); vertices outside
-  // the ROI stay hard.
+  // the ROI stay hard. Soft constraints act in the Eq. 7 solve; the finalize system is square
+  // (one Laplacian row per free vertex, one soft row per constrained one), so there they are met
+  // exactly whatever the weight.
   double soft_constraint_weight = 0.0;
   // Precompute Φ_h so that drag() is a small dense product (4 back-substitutions per handle at
   // precompute). false: drag() does three back-substitutions like drag_positions().
@@ -117,7 +119,8 @@ struct EditStats {
   int widened_stencils = 0;      // valence < 3 centers whose stencil became the 2-ring
   int coherence_pairs = 0;       // |SF| used in E_R
   long system_nonzeros = 0;      // nnz of the lower triangle of AᵀA (stage 1)
-  long factor_nonzeros = 0;      // nnz of its Cholesky factor
+  long factor_nonzeros = 0;      // entries stored in its supernodal Cholesky factor (incl. the
+                                 // explicit zeros of relaxed supernodes)
   double max_condition = 0;      // max cond(V_i V_iᵀ) after the degenerate handling
   double mean_edge_length = 0;   // h, the scale of the edited region (mesh units)
   // Wall time of the precompute stages in ms (for bench/ and the CLI's --verbose; not deterministic).
