@@ -66,6 +66,28 @@ TEST(Edit, ImplicitGradientsAreExactForAffineMotions) {
   EXPECT_LE(worst_sum, 1e-8);
 }
 
+// Sec. 3.3 open-boundary variant: a boundary vertex whose neighbours are collinear cannot be fixed
+// by moving itself; a neighbouring interior vertex is displaced instead.
+//        A            A on top, B C D on a line, E below: A's neighbours B, C, D are collinear;
+//      / | \          C is the only interior vertex.
+//     B--C--D
+//      \ | /
+//        E
+TEST(Edit, DegenerateCollinearNeighboursDisplaceInteriorVertex) {
+  Eigen::MatrixXd V(5, 3);
+  V << 0, 1, 0, -1, 0, 0, 0, 0, 0, 1, 0, 0, 0, -1, 0;
+  Eigen::MatrixXi F(4, 3);
+  F << 0, 1, 2, 0, 2, 3, 1, 4, 2, 2, 4, 3;
+  const auto adj = vertex_adjacency(F, 5);
+  ImplicitGradients g = implicit_gradients(V, F, adj, {0});
+  ASSERT_TRUE(g.status.ok()) << g.status.message;
+  EXPECT_EQ(g.degenerate, (std::vector<int>{0}));
+  EXPECT_EQ(g.displaced, (std::vector<int>{2}));  // C, not A
+  EXPECT_GT(g.V_displaced(2, 2), 0.0);              // along the normal (+z)
+  EXPECT_LE(g.max_condition, 2e5);
+  EXPECT_LE((g.gradient(0, g.V_displaced) - Eigen::Matrix3d::Identity()).norm(), 1e-9);
+}
+
 // Paper Fig. 2 right: the same similarity on every constrained vertex gives the transformed input
 // (max vertex error ≤ 1e-6 of the bbox diagonal). Holds for the stage-1 solve, for drag_positions,
 // with gradient constraints, and for the Eq. 10 finalize (which keeps the uniform scale).

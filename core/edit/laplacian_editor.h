@@ -35,6 +35,12 @@
 // pull-back error over the ROI). Displaced constrained vertices get the handle transform of
 // their displaced position in stage 1 and of their true position in the output.
 //
+// Known limits (measured, docs/edit.md): Eq. 9/10 only rotate Laplacian coordinates, which are
+// zero on flat faces and sum to zero around a tube's cross-section, so a finalized bend is
+// straighter than the stage-1 preview; and the linear coherence term blends rotations through
+// shrunk matrices, so twists approaching π concentrate mid-way (the paper: use intermediate
+// handles for large rotations).
+//
 // Errors (Status codes): InvalidArgument — empty handle set, index out of range, overlapping
 // handle/fixed sets, no free vertex, wrong number of transforms, non-finite transforms or
 // targets, a free region with no constraint; InvalidMesh — non-manifold or degenerate faces in the
