@@ -36,11 +36,7 @@ struct Lcg {
   }
 };
 
-Mesh load(const std::string& rel) {
-  io::LoadResult r = io::load_asset(test::data_path(rel));
-  EXPECT_TRUE(r.status.ok()) << r.status.message;
-  return r.asset.mesh();
-}
+Mesh load(const std::string& rel) { return test::load_mesh(rel); }
 
 // Max over points of |Ψ C − P| and |Ψ 1 − 1|.
 void expect_reproduces(const Eigen::MatrixXd& Psi, const Eigen::MatrixXd& C, const Eigen::MatrixXd& P, double tol) {

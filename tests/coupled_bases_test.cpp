@@ -16,11 +16,7 @@
 
 namespace mm::coupled_test {
 
-Mesh load(const std::string& rel) {
-  io::LoadResult r = io::load_asset(test::data_path(rel));
-  EXPECT_TRUE(r.status.ok()) << r.status.message;
-  return r.asset.mesh();
-}
+Mesh load(const std::string& rel) { return test::load_mesh(rel); }
 
 std::vector<LandmarkPair> load_pairs(const std::string& rel) {
   std::ifstream in(test::data_path(rel));

@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "io/asset.h"
+
 namespace mm::test {
 
 namespace {
@@ -28,6 +30,12 @@ std::string scratch_path(const std::string& name) {
   const std::filesystem::path dir = std::filesystem::current_path() / "test-scratch";
   std::filesystem::create_directories(dir);
   return (dir / name).string();
+}
+
+Mesh load_mesh(const std::string& relative) {
+  const io::LoadResult r = io::load_asset(data_path(relative));
+  EXPECT_TRUE(r.status.ok()) << relative << ": " << r.status.message;
+  return r.asset.mesh();
 }
 
 void expect_golden(const std::string& name, const Eigen::MatrixXd& values, double tolerance) {

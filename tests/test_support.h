@@ -5,6 +5,8 @@
 
 #include <Eigen/Core>
 
+#include "mesh/mesh.h"
+
 namespace mm::test {
 
 // Absolute path of a file under the repository's data/ folder (works natively and in wasm
@@ -14,6 +16,10 @@ std::string data_path(const std::string& relative);
 std::string tests_path(const std::string& relative);
 // A scratch directory under the build tree, created on first use.
 std::string scratch_path(const std::string& name);
+
+// Loads data/<relative> through mm::io and returns the welded mesh; a load failure is a test
+// failure (EXPECT) and gives an empty mesh.
+Mesh load_mesh(const std::string& relative);
 
 // True when the binary was started with --update-golden.
 bool update_golden();
