@@ -3,15 +3,14 @@
 // (Γ ≈ I) and of cat → lion with the repo's landmark file (Γ diagonally dominant).
 #include <gtest/gtest.h>
 
-#include <fstream>
 
-#include <nlohmann/json.hpp>
 
 #include "io/asset.h"
 #include "operators/operators.h"
 #include "spectral/coupled_bases.h"
 #include "spectral/landmarks.h"
 #include "spectral/spectral_basis.h"
+#include "io/landmarks_file.h"
 #include "test_support.h"
 
 namespace mm::coupled_test {
@@ -19,10 +18,9 @@ namespace mm::coupled_test {
 Mesh load(const std::string& rel) { return test::load_mesh(rel); }
 
 std::vector<LandmarkPair> load_pairs(const std::string& rel) {
-  std::ifstream in(test::data_path(rel));
-  nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
   std::vector<LandmarkPair> out;
-  for (const auto& p : j["pairs"]) out.push_back({p[0].get<int>(), p[1].get<int>()});
+  const Status s = io::read_landmarks(test::data_path(rel), &out);
+  EXPECT_TRUE(s.ok()) << s.message;
   return out;
 }
 

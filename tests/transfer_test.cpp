@@ -4,13 +4,12 @@
 // inputs and cancellation.
 #include <gtest/gtest.h>
 
-#include <fstream>
 
-#include <nlohmann/json.hpp>
 
 #include "io/asset.h"
 #include "metrics/transfer_metrics.h"
 #include "transfer/pose_transfer.h"
+#include "io/landmarks_file.h"
 #include "test_support.h"
 
 namespace mm::transfer_test {
@@ -18,10 +17,9 @@ namespace mm::transfer_test {
 Mesh load(const std::string& rel) { return test::load_mesh(rel); }
 
 std::vector<LandmarkPair> load_pairs(const std::string& rel) {
-  std::ifstream in(test::data_path(rel));
-  nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
   std::vector<LandmarkPair> out;
-  for (const auto& p : j["pairs"]) out.push_back({p[0].get<int>(), p[1].get<int>()});
+  const Status s = io::read_landmarks(test::data_path(rel), &out);
+  EXPECT_TRUE(s.ok()) << s.message;
   return out;
 }
 

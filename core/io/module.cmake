@@ -17,3 +17,4 @@ list(APPEND MM_IO_SOURCES
 list(APPEND MM_TEST_SOURCES tests/io_test.cpp tests/io_gltf_test.cpp)
 list(APPEND MM_IO_SOURCES core/io/info_report.cpp)  # owned by the lead: the `info` report shared by CLI and wasm
 include(core/io/animation_sources.cmake OPTIONAL)  # retarget: glTF skins/animations (issue 5)
+list(APPEND MM_IO_SOURCES core/io/landmarks_file.cpp)

@@ -1,12 +1,11 @@
 // `meshmorph transfer` (spectral pose transfer, paper 000) and `meshmorph compare` (metrics).
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 
-#include <nlohmann/json.hpp>
 
 #include "cli.h"
 #include "io/asset.h"
+#include "io/landmarks_file.h"
 #include "metrics/transfer_metrics.h"
 #include "transfer/pose_transfer.h"
 
@@ -29,22 +28,6 @@ const char* kTransferHelp =
     "  --cage-vertices N    automatic cage size (default 300)\n"
     "  --placement P        reference (default) | source: where the result is centred\n"
     "  --cage-out FILE      also write the deformed cage\n";
-
-Status read_landmarks(const std::string& path, std::vector<LandmarkPair>* pairs) {
-  std::vector<uint8_t> bytes;
-  Status s = io::read_file(path, &bytes);
-  if (!s.ok()) return s;
-  nlohmann::json j = nlohmann::json::parse(bytes.begin(), bytes.end(), nullptr, false);
-  if (j.is_discarded() || !j.contains("pairs") || !j["pairs"].is_array())
-    return Status::error(StatusCode::ParseError, path + ": expected a JSON object with an array \"pairs\"");
-  for (size_t i = 0; i < j["pairs"].size(); ++i) {
-    const auto& p = j["pairs"][i];
-    if (!p.is_array() || p.size() != 2 || !p[0].is_number_integer() || !p[1].is_number_integer())
-      return Status::error(StatusCode::ParseError, path + ": pair " + std::to_string(i) + " is not [int, int]");
-    pairs->push_back({p[0].get<int>(), p[1].get<int>()});
-  }
-  return Status::success();
-}
 
 int run_transfer(const std::vector<std::string>& argv) {
   cli::Args args;
@@ -80,7 +63,7 @@ int run_transfer(const std::vector<std::string>& argv) {
   const io::LoadResult src = io::load_asset(args.get("source"));
   if (!src.status.ok()) return cli::report("transfer", src.status);
   std::vector<LandmarkPair> pairs;
-  if (!landmarks_path.empty() && !(s = read_landmarks(landmarks_path, &pairs)).ok()) return cli::report("transfer", s);
+  if (!landmarks_path.empty() && !(s = io::read_landmarks(landmarks_path, &pairs)).ok()) return cli::report("transfer", s);
   Mesh cage;
   if (!cage_path.empty()) {
     const io::LoadResult c = io::load_asset(cage_path);
