@@ -26,6 +26,8 @@ const char* kTransferHelp =
     "  --num-low-frequencies K   transferred coefficients 0..K (default 5)\n"
     "  --num-eigenpairs N   eigenpairs per mesh (default 20)\n"
     "  --cage-vertices N    automatic cage size (default 300)\n"
+    "  --cage-resolution N  offset grid cells along the longest side for the automatic cage (default 80)\n"
+    "  --max-iterations N   re-linearizations of the cage solve (default 50)\n"
     "  --placement P        reference (default) | source: where the result is centred\n"
     "  --cage-out FILE      also write the deformed cage\n";
 
@@ -48,6 +50,8 @@ int run_transfer(const std::vector<std::string>& argv) {
   opt.num_low_frequencies = args.get_int("num-low-frequencies", opt.num_low_frequencies, &perr);
   opt.num_eigenpairs = args.get_int("num-eigenpairs", opt.num_eigenpairs, &perr);
   opt.cage.target_vertices = args.get_int("cage-vertices", opt.cage.target_vertices, &perr);
+  opt.cage.resolution = args.get_int("cage-resolution", opt.cage.resolution, &perr);
+  opt.solver.max_iterations = args.get_int("max-iterations", opt.solver.max_iterations, &perr);
   if (!perr.ok()) return cli::report("transfer", perr);
   const std::string method = args.get("method", "yin");
   if (!parse_transfer_method(method, &opt.method))
