@@ -159,12 +159,12 @@ TEST(Edit, HandleBasisMatchesBackSubstitution) {
 }
 
 struct EditTestComparison {
-  Eigen::VectorXd ours, naive;  // per-vertex local rigidity error after finalize
+  Eigen::VectorXd ours, naive, ideal;  // per-vertex local rigidity error after finalize / reference
   size_t inverted_ours = 0, inverted_naive = 0;
   double shear_before = 0, shear_after = 0;
 };
 
-EditTestComparison edit_test_compare(const BarCase& b) {
+EditTestComparison edit_test_compare(const BarCase& b, bool bend) {
   EditTestComparison c;
   LaplacianEditor ed;
   EXPECT_TRUE(ed.precompute(b.mesh.V, b.mesh.F, b.region).ok());
@@ -178,41 +178,65 @@ EditTestComparison edit_test_compare(const BarCase& b) {
   EXPECT_TRUE(nv.status.ok()) << nv.status.message;
   c.ours = local_rigidity_error(b.mesh.V, f.V, b.mesh.F);
   c.naive = local_rigidity_error(b.mesh.V, nv.V, b.mesh.F);
+  c.ideal = local_rigidity_error(b.mesh.V, ideal_bar_deformation(b.mesh.V, bend), b.mesh.F);
   c.inverted_ours = inverted_faces(b.mesh.V, f.V, b.mesh.F).size();
   c.inverted_naive = inverted_faces(b.mesh.V, nv.V, b.mesh.F).size();
   c.shear_before = gradient_shear(ed.gradients()).mean();
   c.shear_after = gradient_shear(fitted_gradients(b.mesh.V, f.V, b.mesh.F)).mean();
+  std::cout << "[ rigidity error mean / p90 / max ] ours " << c.ours.mean() << " / " << quantile(c.ours, 0.9) << " / "
+            << c.ours.maxCoeff() << ", naive " << c.naive.mean() << " / " << quantile(c.naive, 0.9) << " / "
+            << c.naive.maxCoeff() << ", ideal " << c.ideal.mean() << "; inverted ours " << c.inverted_ours
+            << ", naive " << c.inverted_naive << "\n";
+  ::testing::Test::RecordProperty("ours_mean", std::to_string(c.ours.mean()));
+  ::testing::Test::RecordProperty("naive_mean", std::to_string(c.naive.mean()));
+  ::testing::Test::RecordProperty("ideal_mean", std::to_string(c.ideal.mean()));
   return c;
 }
 
-// Bar bent 90° into a quarter circle by one end, other end fixed. Measured (see the report):
-// ours mean 0.111 / p90 0.20 / max 0.35; naive 0.196 / 0.35 / 0.77 with 4 inverted triangles.
-// The issue asks for a 3× lower mean; on this coarse, flat-sided bar the Eq. 9 Poisson step cannot
-// encode the bend of the flat sides (their Laplacian coordinates are zero, so any rotation of them
-// is zero too) and the bar's own bending strain (±21% at the surface) is a floor for any method;
-// we assert what holds with margin: ≥ 1.5× lower mean and p90, ≥ 2× lower max, no inversion.
+// Bar (data/edit/bar.ply) bent 90° into a quarter circle by one end, other end fixed. Measured:
+// ours mean 0.061 / p90 0.11 / max 0.27, naive 0.196 / 0.35 / 0.77 with 4 inverted faces; the
+// ideal bend of this short, thick bar (±21% strain at its surface) has 0.05 itself.
 TEST(Edit, BarBend90BeatsNaiveLaplacian) {
-  const EditTestComparison c = edit_test_compare(bar_case(true));
-  EXPECT_LE(c.ours.mean() * 1.5, c.naive.mean());
-  EXPECT_LE(quantile(c.ours, 0.9) * 1.5, quantile(c.naive, 0.9));
-  EXPECT_LE(c.ours.maxCoeff() * 2.0, c.naive.maxCoeff());
+  const EditTestComparison c = edit_test_compare(bar_case(true), true);
+  EXPECT_LE(c.ours.mean() * 3.0, c.naive.mean());  // the issue's bound
+  EXPECT_LE(quantile(c.ours, 0.9) * 3.0, quantile(c.naive, 0.9));
+  EXPECT_LE(c.ours.mean(), 1.5 * c.ideal.mean());
   EXPECT_EQ(c.inverted_ours, 0u);
   EXPECT_GT(c.inverted_naive, 0u);
   EXPECT_LT(c.shear_after, c.shear_before);  // Sec. 4: shear removal
 }
 
-// Bar twisted by 150° about its axis. Linear coherence (Eq. 6) blends I and R(150°) through
-// strongly scaled matrices, so twist concentrates mid-bar; still, ours has no inverted triangle
-// and much lower worst-case distortion than the naive candy-wrapper (measured max 0.40 vs 0.70,
-// p90 0.26 vs 0.40). The MEAN is not lower (0.140 vs 0.115): naive keeps most rings untouched and
-// collapses a few next to the handle, which a mean rewards.
+// The same bend of a slender cylinder (length 20 radii): measured ours 0.026, naive 0.21 (8×).
+TEST(Edit, SlenderCylinderBend90BeatsNaiveLaplacian) {
+  const EditTestComparison c = edit_test_compare(bar_case_of(slender_cylinder(), true), true);
+  EXPECT_LE(c.ours.mean() * 5.0, c.naive.mean());
+  EXPECT_LE(c.ours.mean(), 2.0 * c.ideal.mean() + 0.01);
+  EXPECT_EQ(c.inverted_ours, 0u);
+  EXPECT_GT(c.inverted_naive, 0u);
+}
+
+// Twist by 150° about the long axis. The issue asks for a 3× lower mean rigidity error than naive
+// Laplacian editing; that is not reachable by any deformation that spreads the twist: the ideal
+// uniform twist (rigid cross-sections) has a mean error close to naive's, because naive keeps most
+// 1-rings untouched and collapses the bar next to the handle (candy wrapper: the slender
+// cylinder's radius drops to 0.36 r there), which a
+// mean rewards. What we assert instead: no inverted face (naive has them), a much lower worst
+// case and 90th percentile, and a mean within a small factor of the ideal twist's.
 TEST(Edit, BarTwist150AvoidsCandyWrapper) {
-  const EditTestComparison c = edit_test_compare(bar_case(false));
+  const EditTestComparison c = edit_test_compare(bar_case(false), false);
   EXPECT_LE(c.ours.maxCoeff() * 1.5, c.naive.maxCoeff());
   EXPECT_LE(quantile(c.ours, 0.9) * 1.3, quantile(c.naive, 0.9));
+  EXPECT_LE(c.ours.mean(), 1.5 * c.ideal.mean());
   EXPECT_EQ(c.inverted_ours, 0u);
   EXPECT_GT(c.inverted_naive, 0u);
   EXPECT_LT(c.shear_after, c.shear_before);
+}
+
+TEST(Edit, SlenderCylinderTwist150) {
+  const EditTestComparison c = edit_test_compare(bar_case_of(slender_cylinder(), false), false);
+  EXPECT_LE(c.ours.maxCoeff() * 1.5, c.naive.maxCoeff());
+  EXPECT_LE(c.ours.mean(), 1.5 * c.ideal.mean());
+  EXPECT_EQ(c.inverted_ours, 0u);
 }
 
 // Translation-only drag of the hand of a character: the arm's details must rotate with it.
@@ -236,6 +260,8 @@ TEST(Edit, LimbTranslationRotatesDetails) {
   EXPECT_LE(d_ours.mean_angle_deg, 10.0);
   EXPECT_GE(d_naive.mean_angle_deg, 1.5 * d_ours.mean_angle_deg);
   EXPECT_TRUE(inverted_faces(c.mesh.V, ours.V, c.mesh.F).empty());
+  std::cout << "[ limb detail angle ] ours " << d_ours.mean_angle_deg << "°, naive " << d_naive.mean_angle_deg
+            << "°, rest " << d_ours.rest_mean_angle_deg << "°\n";
   (void)T;
 }
 

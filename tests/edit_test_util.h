@@ -75,10 +75,87 @@ inline Mesh subdivide(const Mesh& m) {
   return out;
 }
 
+// Closed slender cylinder along x (radius r, length len, `around` × `along` quads split into
+// triangles, alternate rings rotated by half a step, flat caps fanned from their centres). CCW
+// from outside. Used for the bend/twist comparisons on a thin part (len / r = 20 by default).
+inline Mesh slender_cylinder(double r = 0.05, double len = 1.0, int around = 24, int along = 100) {
+  Mesh m;
+  m.V.resize((along + 1) * around + 2, 3);
+  for (int j = 0; j <= along; ++j)
+    for (int i = 0; i < around; ++i) {
+      const double a = 2 * M_PI * (i + 0.5 * (j % 2)) / around;
+      m.V.row(j * around + i) << -len / 2 + len * j / along, r * std::cos(a), r * std::sin(a);
+    }
+  const int c0 = (along + 1) * around, c1 = c0 + 1;
+  m.V.row(c0) << -len / 2, 0, 0;
+  m.V.row(c1) << len / 2, 0, 0;
+  std::vector<Eigen::RowVector3i> F;
+  for (int j = 0; j < along; ++j)
+    for (int i = 0; i < around; ++i) {
+      const int a = j * around + i, b = j * around + (i + 1) % around, c = a + around, d = b + around;
+      if (j % 2 == 0) {
+        F.emplace_back(a, b, c);
+        F.emplace_back(b, d, c);
+      } else {
+        F.emplace_back(a, d, c);
+        F.emplace_back(a, b, d);
+      }
+    }
+  for (int i = 0; i < around; ++i) {
+    F.emplace_back(c0, (i + 1) % around, i);
+    F.emplace_back(c1, along * around + i, along * around + (i + 1) % around);
+  }
+  m.F.resize(static_cast<Eigen::Index>(F.size()), 3);
+  for (size_t f = 0; f < F.size(); ++f) m.F.row(static_cast<Eigen::Index>(f)) = F[f];
+  return m;
+}
+
+BarCase bar_case_of(Mesh mesh, bool bend);
+
 inline BarCase bar_case(bool bend, const std::string& file = "edit/bar.ply", int subdivisions = 0) {
+  Mesh m = load(file);
+  for (int k = 0; k < subdivisions; ++k) m = subdivide(m);
+  return bar_case_of(std::move(m), bend);
+}
+
+// The ideal bend or twist of a bar case, for reference: cross-sections stay rigid, the free part
+// (between the fixed and the handle slab) bends along a circular arc by 90° / twists uniformly by
+// 150°, the parts beyond it move rigidly. Its local rigidity error is the bending / torsion strain
+// of the bar itself, which no deformation with these end conditions avoids.
+inline Eigen::MatrixXd ideal_bar_deformation(const Eigen::MatrixXd& V, bool bend) {
+  const int ax = long_axis(V), up = (ax + 1) % 3, side = (ax + 2) % 3;
+  const double lo = V.col(ax).minCoeff(), hi = V.col(ax).maxCoeff();
+  const double s0 = lo + 0.1 * (hi - lo), s1 = hi - 0.1 * (hi - lo);
+  const Eigen::RowVector3d mid = 0.5 * (V.colwise().minCoeff() + V.colwise().maxCoeff());
+  Eigen::MatrixXd out = V;
+  for (int i = 0; i < V.rows(); ++i) {
+    const double s = V(i, ax), u = V(i, up) - mid[up], w = V(i, side) - mid[side];
+    const double t = std::clamp((s - s0) / (s1 - s0), 0.0, 1.0);
+    Eigen::Vector3d e_ax = Eigen::Vector3d::Zero(), e_up = e_ax, e_side = e_ax, p;
+    e_ax[ax] = 1;
+    e_up[up] = 1;
+    e_side[side] = 1;
+    const Eigen::Vector3d base = mid.transpose() + (s0 - mid[ax]) * e_ax;  // centre line at s0
+    if (s <= s0) continue;
+    if (bend) {
+      const double R = (s1 - s0) / (M_PI / 2), phi = t * M_PI / 2;
+      const Eigen::Vector3d C = base + R * e_up;
+      const Eigen::Vector3d P = C + R * (std::sin(phi) * e_ax - std::cos(phi) * e_up);
+      const Eigen::Vector3d T = std::cos(phi) * e_ax + std::sin(phi) * e_up;
+      const Eigen::Vector3d N = std::cos(phi) * e_up - std::sin(phi) * e_ax;
+      p = P + std::max(0.0, s - s1) * T + u * N + w * e_side;
+    } else {
+      const double a = t * 150.0 * M_PI / 180.0;
+      p = base + (s - s0) * e_ax + (std::cos(a) * u - std::sin(a) * w) * e_up + (std::sin(a) * u + std::cos(a) * w) * e_side;
+    }
+    out.row(i) = p.transpose();
+  }
+  return out;
+}
+
+inline BarCase bar_case_of(Mesh mesh, bool bend) {
   BarCase b;
-  b.mesh = load(file);
-  for (int k = 0; k < subdivisions; ++k) b.mesh = subdivide(b.mesh);
+  b.mesh = std::move(mesh);
   const Eigen::MatrixXd& V = b.mesh.V;
   const int ax = long_axis(V);
   b.region.fixed = slab(V, ax, 0.1, false);

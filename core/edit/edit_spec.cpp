@@ -302,7 +302,8 @@ EditSpecResult parse_edit_spec(const std::string& json_text, const Eigen::Matrix
       LaplacianEditOptions& opt = spec.options;
       if (!o.is_object() || !p.check_keys(o, {"method", "weights", "coherence_rings", "coherence_weight",
                                               "condition_threshold", "displacement_scale",
-                                              "gradient_constraint_weight", "soft_constraint_weight", "handle_basis"},
+                                              "gradient_constraint_weight", "soft_constraint_weight", "handle_basis",
+                                              "rotated_coordinates", "finalize_refinements"},
                                           "options")) {
         out.status = p.status.ok() ? Status::error(StatusCode::ParseError, "options must be an object") : p.status;
         return out;
@@ -315,11 +316,15 @@ EditSpecResult parse_edit_spec(const std::string& json_text, const Eigen::Matrix
         *first = v.get<std::string>() == a;
         return true;
       };
-      bool implicit = true, cot = true;
-      bool ok = str("method", "implicit", "naive", &implicit) && str("weights", "cotangent", "uniform", &cot);
+      bool implicit = true, cot = true, per_edge = true;
+      bool ok = str("method", "implicit", "naive", &implicit) && str("weights", "cotangent", "uniform", &cot) &&
+                str("rotated_coordinates", "per_edge", "per_vertex", &per_edge);
+      opt.rotated_coordinates = per_edge ? RotatedCoordinates::PerEdge : RotatedCoordinates::PerVertex;
       opt.method = implicit ? EditMethod::Implicit : EditMethod::NaiveLaplacian;
       opt.weights = cot ? LaplacianWeights::Cotangent : LaplacianWeights::Uniform;
       if (ok && o.contains("coherence_rings")) ok = p.integer(o["coherence_rings"], "options.coherence_rings", &opt.coherence_rings);
+      if (ok && o.contains("finalize_refinements"))
+        ok = p.integer(o["finalize_refinements"], "options.finalize_refinements", &opt.finalize_refinements);
       const std::pair<const char*, double*> numbers[] = {
           {"coherence_weight", &opt.coherence_weight},
           {"condition_threshold", &opt.condition_threshold},

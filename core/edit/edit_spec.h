@@ -11,7 +11,9 @@
 //     "options": { "method": "implicit" | "naive", "weights": "cotangent" | "uniform",
 //                  "coherence_rings": 2, "coherence_weight": 1, "condition_threshold": 2e5,
 //                  "displacement_scale": 0.2, "gradient_constraint_weight": 0,
-//                  "soft_constraint_weight": 0, "handle_basis": true }   (LaplacianEditOptions)
+//                  "soft_constraint_weight": 0, "handle_basis": true,
+//                  "rotated_coordinates": "per_edge"|"per_vertex", "finalize_refinements": 1 }
+//                                                                     (LaplacianEditOptions)
 //   }
 //   SELECTION: [i, j, ...]  or  { "indices": [...], "spheres": [{"center": [x,y,z] | "vertex": i,
 //              "radius": r | "radius_rel": r}], "boxes": [{"min": [..], "max": [..]}],

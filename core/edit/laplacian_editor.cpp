@@ -23,6 +23,7 @@ namespace mm {
 namespace edit_detail {
 
 using EditSparse = Eigen::SparseMatrix<double>;
+using RowSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 using EditTriplet = Eigen::Triplet<double>;
 
 // Vertices within `k` edges of any seed (multi-source BFS), marked in `mark` (size #V) with the
@@ -206,6 +207,8 @@ struct LaplacianEditor::Impl {
   SupernodalCholesky solver2;
   edit_detail::EditSparse D2_UU, D2_UK;  // hard: W_UU, W_UK; soft: row-scaled D rows of unknowns
   Eigen::MatrixXd LC;                // nU by 3: (W V)_i of the unknowns (rest Laplacian coordinates)
+  edit_detail::RowSparse W2_rows;    // W_UU | W_UK (nU by nL), rows for the per-edge right-hand side
+  Eigen::MatrixXd X2_rest;           // nL by 3: rest positions in local numbering
   Eigen::VectorXd row_scale2;        // soft mode: per-unknown row scale of D (2h/A_i or 1/(h·deg))
 
   // Last drag.
@@ -249,6 +252,8 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
   // ---- options and inputs
   if (!(opt.coherence_rings >= 1 && opt.coherence_rings <= 3))
     return Status::error(StatusCode::InvalidArgument, "coherence_rings must be 1, 2 or 3");
+  if (!(opt.finalize_refinements >= 0 && opt.finalize_refinements <= 100))
+    return Status::error(StatusCode::InvalidArgument, "finalize_refinements must be between 0 and 100");
   if (!(opt.coherence_weight > 0) || !(opt.condition_threshold > 1) || !(opt.displacement_scale > 0) ||
       !(opt.gradient_constraint_weight >= 0) || !(opt.soft_constraint_weight >= 0) ||
       !std::isfinite(opt.coherence_weight + opt.condition_threshold + opt.displacement_scale +
@@ -491,6 +496,8 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     Eigen::MatrixXd Xrest(nL, 3);
     for (int l = 0; l < nL; ++l) Xrest.row(l) = V.row(l2g[l]);
     LC = W2 * Xrest;
+    W2_rows = W2;
+    X2_rest = Xrest;
     if (!soft_mode) {
       D2_UU = W2.leftCols(nU);
       D2_UK = W2.rightCols(nL - nU);
@@ -801,30 +808,89 @@ EditResult LaplacianEditor::Impl::output_stage1() {
 
 EditResult LaplacianEditor::Impl::solve_stage2(bool use_rotations, FeatureSize mode) {
   EditResult out;
-  Eigen::MatrixXd b(nU, 3);
-  if (use_rotations) {
-    // Sec. 4: M_i = U W Vᵀ → R_i = U Vᵀ, s_i = sqrt((λ1² + λ2² + λ3²)/3); b_i = R_i S_i δ_i
-    // (Eq. 10) or R_i δ_i (Eq. 9), with δ_i = (W v)_i up to the row factor that cancels.
+  Eigen::MatrixXd b(nU, 3), x;
+  auto solve2 = [&](const Eigen::MatrixXd& bb, Eigen::MatrixXd* xx) {
+    Eigen::MatrixXd rhs;
+    if (opt.soft_constraint_weight > 0) {
+      rhs = D2_UU.transpose() * (row_scale2.asDiagonal() * bb - D2_UK * known);
+      for (int l = 0; l < nU; ++l)
+        if (soft[l] > 0) rhs.row(l) += soft[l] * soft_u.row(l);
+    } else {
+      rhs = bb - D2_UK * known;
+    }
+    return solver2.solve(rhs, xx);
+  };
+  // The same equation with δ_i = Σ_j w_ij (v_i − v_j) rotated edge by edge:
+  // b_i = Σ_j w_ij s_ij R_ij (v_i − v_j) with R_ij the midpoint of R_i and R_j (rotation part of
+  // their mean, the geodesic midpoint for angles < π) and s_ij the mean scale. Equal to T_i δ_i
+  // where T is constant; where it varies, the difference carries the bend of thin parts.
+  auto per_edge_rhs = [&](const std::vector<Eigen::Matrix3d>& T, const std::vector<double>& S, Eigen::MatrixXd* bb) {
+    std::vector<Eigen::Quaterniond> q(T.size());
+    for (size_t l = 0; l < T.size(); ++l) q[l] = Eigen::Quaterniond(T[l]);
     for (int l = 0; l < nU; ++l) {
-      const Eigen::Matrix3d M = gradient_local(l);
-      double s = 1.0;
-      if (mode == FeatureSize::Scale) s = std::sqrt(M.squaredNorm() / 3.0);  // Σσ² = ||M||²_F
-      b.row(l) = (s * (rotation_part(M) * LC.row(l).transpose())).transpose();
+      Eigen::Vector3d acc = Eigen::Vector3d::Zero();
+      for (edit_detail::RowSparse::InnerIterator it(W2_rows, l); it; ++it) {
+        const int j = static_cast<int>(it.col());
+        if (j == l) continue;
+        // Geodesic midpoint of the two rotations: the normalized sum of their quaternions (same
+        // hemisphere).
+        const Eigen::Quaterniond qj = q[l].dot(q[j]) < 0 ? Eigen::Quaterniond(-q[j].coeffs()) : q[j];
+        const Eigen::Quaterniond qm = Eigen::Quaterniond(q[l].coeffs() + qj.coeffs()).normalized();
+        acc.noalias() -= it.value() * (0.5 * (S[l] + S[j])) * (qm * Eigen::Vector3d((X2_rest.row(l) - X2_rest.row(j)).transpose()));
+      }
+      bb->row(l) = acc.transpose();
+    }
+  };
+  if (use_rotations) {
+    // Sec. 4: M_i = U W Vᵀ → R_i = U Vᵀ, s_i = sqrt((λ1² + λ2² + λ3²)/3); T_i = R_i (Eq. 9) or
+    // R_i S_i (Eq. 10). Constrained vertices (hard or soft) take their handle's similarity, fixed
+    // ones the identity.
+    std::vector<Eigen::Matrix3d> T(opt.rotated_coordinates == RotatedCoordinates::PerEdge ? nL : nU);
+    std::vector<double> S(T.size());
+    for (int l = 0; l < static_cast<int>(T.size()); ++l) {
+      const int g = group[l];
+      const Eigen::Matrix3d M = g == -2 && center_of[l] >= 0 ? gradient_local(l)  // free unknown
+                                : g >= 0                         ? linear[g]
+                                                                 : Eigen::Matrix3d::Identity();
+      const double s = mode == FeatureSize::Scale ? std::sqrt(M.squaredNorm() / 3.0) : 1.0;  // Σσ² = ||M||²_F
+      T[l] = rotation_part(M);
+      S[l] = s;
+    }
+    if (opt.rotated_coordinates == RotatedCoordinates::PerVertex) {
+      // Eq. 9/10 literally: b_i = T_i δ_i with δ_i = (W v)_i (the row factor of D cancels).
+      for (int l = 0; l < nU; ++l) b.row(l) = (S[l] * (T[l] * LC.row(l).transpose())).transpose();
+    } else {
+      per_edge_rhs(T, S, &b);
+    }
+    Status st = solve2(b, &x);
+    // Optional local/global refinement (not in the paper): re-fit each free vertex's rotation to
+    // its finalized 1-ring (cotangent-weighted, rest edges → deformed edges) and solve again.
+    const int refinements = opt.rotated_coordinates == RotatedCoordinates::PerEdge ? opt.finalize_refinements : 0;
+    for (int it = 0; it < refinements && st.ok(); ++it) {
+      for (int l = 0; l < nU; ++l) {
+        if (group[l] != -2) continue;
+        Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+        for (edit_detail::RowSparse::InnerIterator e(W2_rows, l); e; ++e) {
+          const int j = static_cast<int>(e.col());
+          if (j == l) continue;
+          const Eigen::RowVector3d xj = j < nU ? Eigen::RowVector3d(x.row(j)) : Eigen::RowVector3d(known.row(j - nU));
+          A += std::abs(e.value()) * (x.row(l) - xj).transpose() * (X2_rest.row(l) - X2_rest.row(j));
+        }
+        T[l] = rotation_part(A);
+      }
+      per_edge_rhs(T, S, &b);
+      st = solve2(b, &x);
+    }
+    if (!st.ok()) {
+      out.status = st;
+      return out;
     }
   } else {
     b = LC;  // naive Laplacian editing: unrotated Laplacian coordinates
-  }
-  Eigen::MatrixXd rhs, x;
-  if (opt.soft_constraint_weight > 0) {
-    rhs = D2_UU.transpose() * (row_scale2.asDiagonal() * b - D2_UK * known);
-    for (int l = 0; l < nU; ++l)
-      if (soft[l] > 0) rhs.row(l) += soft[l] * soft_u.row(l);
-  } else {
-    rhs = b - D2_UK * known;
-  }
-  if (Status s = solver2.solve(rhs, &x); !s.ok()) {
-    out.status = s;
-    return out;
+    if (Status st = solve2(b, &x); !st.ok()) {
+      out.status = st;
+      return out;
+    }
   }
   out.V = V;
   for (int l = 0; l < nU; ++l) out.V.row(l2g[l]) = x.row(l);
