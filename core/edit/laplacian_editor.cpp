@@ -207,8 +207,11 @@ struct LaplacianEditor::Impl {
   SupernodalCholesky solver2;
   edit_detail::EditSparse D2_UU, D2_UK;  // hard: W_UU, W_UK; soft: row-scaled D rows of unknowns
   Eigen::MatrixXd LC;                // nU by 3: (W V)_i of the unknowns (rest Laplacian coordinates)
-  edit_detail::RowSparse W2_rows;    // W_UU | W_UK (nU by nL), rows for the per-edge right-hand side
-  Eigen::MatrixXd X2_rest;           // nL by 3: rest positions in local numbering
+  // Edges of the unknowns for the per-edge right-hand side: unknown l owns entries
+  // [edge_begin[l], edge_begin[l+1]) with the other end (local), w_ij of W and rest v_i − v_j.
+  std::vector<int> edge_begin, edge_end_vertex;
+  std::vector<double> edge_weight;
+  std::vector<Eigen::Vector3d> edge_rest;
   Eigen::VectorXd row_scale2;        // soft mode: per-unknown row scale of D (2h/A_i or 1/(h·deg))
 
   // Last drag.
@@ -496,8 +499,18 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     Eigen::MatrixXd Xrest(nL, 3);
     for (int l = 0; l < nL; ++l) Xrest.row(l) = V.row(l2g[l]);
     LC = W2 * Xrest;
-    W2_rows = W2;
-    X2_rest = Xrest;
+    const edit_detail::RowSparse rows = W2;
+    edge_begin.assign(1, 0);
+    for (int l = 0; l < nU; ++l) {
+      for (edit_detail::RowSparse::InnerIterator it(rows, l); it; ++it) {
+        const int j = static_cast<int>(it.col());
+        if (j == l || it.value() == 0) continue;
+        edge_end_vertex.push_back(j);
+        edge_weight.push_back(-it.value());  // W is PSD: off-diagonal −w_ij
+        edge_rest.emplace_back((Xrest.row(l) - Xrest.row(j)).transpose());
+      }
+      edge_begin.push_back(static_cast<int>(edge_end_vertex.size()));
+    }
     if (!soft_mode) {
       D2_UU = W2.leftCols(nU);
       D2_UK = W2.rightCols(nL - nU);
@@ -829,14 +842,13 @@ EditResult LaplacianEditor::Impl::solve_stage2(bool use_rotations, FeatureSize m
     for (size_t l = 0; l < T.size(); ++l) q[l] = Eigen::Quaterniond(T[l]);
     for (int l = 0; l < nU; ++l) {
       Eigen::Vector3d acc = Eigen::Vector3d::Zero();
-      for (edit_detail::RowSparse::InnerIterator it(W2_rows, l); it; ++it) {
-        const int j = static_cast<int>(it.col());
-        if (j == l) continue;
+      for (int e = edge_begin[l]; e < edge_begin[l + 1]; ++e) {
+        const int j = edge_end_vertex[e];
         // Geodesic midpoint of the two rotations: the normalized sum of their quaternions (same
         // hemisphere).
         const Eigen::Quaterniond qj = q[l].dot(q[j]) < 0 ? Eigen::Quaterniond(-q[j].coeffs()) : q[j];
         const Eigen::Quaterniond qm = Eigen::Quaterniond(q[l].coeffs() + qj.coeffs()).normalized();
-        acc.noalias() -= it.value() * (0.5 * (S[l] + S[j])) * (qm * Eigen::Vector3d((X2_rest.row(l) - X2_rest.row(j)).transpose()));
+        acc.noalias() += (edge_weight[e] * 0.5 * (S[l] + S[j])) * (qm * edge_rest[e]);
       }
       bb->row(l) = acc.transpose();
     }
@@ -870,11 +882,11 @@ EditResult LaplacianEditor::Impl::solve_stage2(bool use_rotations, FeatureSize m
       for (int l = 0; l < nU; ++l) {
         if (group[l] != -2) continue;
         Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-        for (edit_detail::RowSparse::InnerIterator e(W2_rows, l); e; ++e) {
-          const int j = static_cast<int>(e.col());
-          if (j == l) continue;
-          const Eigen::RowVector3d xj = j < nU ? Eigen::RowVector3d(x.row(j)) : Eigen::RowVector3d(known.row(j - nU));
-          A += std::abs(e.value()) * (x.row(l) - xj).transpose() * (X2_rest.row(l) - X2_rest.row(j));
+        const Eigen::Vector3d xl = x.row(l).transpose();
+        for (int e = edge_begin[l]; e < edge_begin[l + 1]; ++e) {
+          const int j = edge_end_vertex[e];
+          const Eigen::Vector3d xj = j < nU ? Eigen::Vector3d(x.row(j).transpose()) : Eigen::Vector3d(known.row(j - nU).transpose());
+          A.noalias() += std::abs(edge_weight[e]) * (xl - xj) * edge_rest[e].transpose();
         }
         T[l] = rotation_part(A);
       }
