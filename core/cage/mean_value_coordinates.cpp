@@ -42,7 +42,9 @@ MeanValueCoordinates mean_value_coordinates(const Eigen::MatrixXd& P, const Eige
   const double vertex_eps = 1e-12 * scale;
   constexpr double kPi = 3.14159265358979323846;
 
-  out.Psi.setZero(np, nc);
+  // Filled column by column (one point per column, contiguous) and transposed at the end: writing
+  // the rows of a column-major #P × #C matrix directly is strided and was most of the time.
+  Eigen::MatrixXd PsiT = Eigen::MatrixXd::Zero(nc, np);
   std::vector<double> ux(nc), uy(nc), uz(nc), d(nc), w(nc);
   std::vector<double> th(ne), sn(ne), cs(ne);
   for (int p = 0; p < np; ++p) {
@@ -65,7 +67,7 @@ MeanValueCoordinates mean_value_coordinates(const Eigen::MatrixXd& P, const Eige
       uz[j] = ez / dj;
     }
     if (at_vertex >= 0) {
-      out.Psi(p, at_vertex) = 1.0;
+      PsiT(at_vertex, p) = 1.0;
       continue;
     }
     for (int e = 0; e < ne; ++e) {
@@ -115,8 +117,9 @@ MeanValueCoordinates mean_value_coordinates(const Eigen::MatrixXd& P, const Eige
       return out;
     }
     const double inv = 1.0 / sum;
-    for (int j = 0; j < nc; ++j) out.Psi(p, j) = w[j] * inv;
+    for (int j = 0; j < nc; ++j) PsiT(j, p) = w[j] * inv;
   }
+  out.Psi = PsiT.transpose();
   if (!out.Psi.allFinite()) {
     out.status = Status::error(StatusCode::NumericalError, "mean-value coordinates are not finite");
     return out;
