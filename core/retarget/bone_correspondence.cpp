@@ -14,6 +14,24 @@ Eigen::Matrix3d rotation_between(const Eigen::Vector3d& a, const Eigen::Vector3d
   return Eigen::Quaterniond::FromTwoVectors(a, b).toRotationMatrix();
 }
 
+// Distances along the ray p + s·dir (unit dir) at which it crosses the surface, nearest first,
+// up to max_s and at most max_hits of them. After a hit the ray restarts `step` past it (a hit
+// on an edge shared by two triangles counts once); callers pass the same step to rays they
+// compare, so that both see the same crossings.
+std::vector<double> ray_hits(const TriangleBvh& bvh, const Eigen::Vector3d& p, const Eigen::Vector3d& dir,
+                             double max_s, int max_hits, double step) {
+  std::vector<double> hits;
+  double s0 = 0;
+  while (static_cast<int>(hits.size()) < max_hits) {
+    const double s = bvh.ray_first_hit(p + s0 * dir, dir, max_s - s0);
+    if (s < 0) break;
+    hits.push_back(s0 + s);
+    s0 += s + step;
+    if (s0 >= max_s) break;
+  }
+  return hits;
+}
+
 }  // namespace retarget_detail
 
 BoneCorrespondence bone_correspondence(const Eigen::MatrixXd& Y, const std::vector<std::pair<int, int>>& bones,
@@ -67,9 +85,28 @@ BoneCorrespondence bone_correspondence(const Eigen::MatrixXd& Y, const std::vect
     }
     const Eigen::Vector3d dir = Rb[pick] * (o / len);
     // Radii along the direction on both shapes: the point keeps its fraction of the radius.
-    const double rt = bvh_t.ray_first_hit(qb[pick], o / len, 4 * len);
-    const double rs = bvh_s.ray_first_hit(qs, dir, 8 * len);
-    const double frac = rt > 0 ? std::min(1.0, len / rt) : 1.0;
+    // Characters made of interpenetrating parts (KayKit: arms and legs reach into the body) have
+    // buried surfaces, so the ray from the bone may cross the surface before it reaches y. The
+    // target radius r_t is the crossing nearest to y (y itself: y lies on the target surface);
+    // on the source ray we take the crossing nearest to r_t scaled by the ratio of the two first
+    // crossings (the bones' thickness ratio). A bone that sees y gets the first crossings on both
+    // sides (as before); identical characters get x = y also through buried layers. Choosing by
+    // distance, not by counting crossings, keeps the choice stable when a ray grazes an edge
+    // (a crossing counted on one platform and missed on another).
+    const double step = 1e-6 * len;
+    const std::vector<double> ht = retarget_detail::ray_hits(bvh_t, qb[pick], o / len, 4 * len, 16, step);
+    const std::vector<double> hs = retarget_detail::ray_hits(bvh_s, qs, dir, 8 * len, 16, step);
+    auto nearest = [](const std::vector<double>& h, double target) {
+      double best = h[0];
+      for (double s : h)
+        if (std::abs(s - target) < std::abs(best - target)) best = s;
+      return best;
+    };
+    const double rt = ht.empty() ? -1.0 : nearest(ht, len);
+    const double rs = hs.empty() || ht.empty() ? (hs.empty() ? -1.0 : hs[0]) : nearest(hs, rt * hs[0] / ht[0]);
+    // y at the same fraction of the radius (≈1: r_t is normally y's own crossing; when the ray
+    // slipped through a seam past y it is a neighbouring crossing and the fraction corrects it).
+    const double frac = rt > 0 ? len / rt : 1.0;
     const double radius = rs > 0 ? rs : len;
     r.X.row(i) = (qs + dir * frac * radius).transpose();
   }

@@ -6,7 +6,8 @@
 // without crossing the surface, at parameter u ∈ [0, 1] along it with radial offset o. Its source
 // counterpart is the point at the same u on the matched source bone, in the direction of o turned
 // by the rotation between the two rest bones, at the same fraction of the source's radius in that
-// direction (found by casting a ray to the source surface). Identical characters get x = y.
+// direction (found by casting rays to both surfaces; crossings of buried layers of
+// interpenetrating parts are counted alike on both). Identical characters get x = y.
 #pragma once
 
 #include <vector>
@@ -24,8 +25,8 @@ struct BoneCorrespondence {
 };
 
 // Y: #Y by 3 target points; bones: (child, parent) rows into Jt/Js (#J by 3 rest joints of
-// target and source, same order). bvh_t / bvh_s: the rest surfaces. `radial_fraction_of_surface`:
-// true for points on the target surface (then r_t = ‖o‖ exactly).
+// target and source, same order). bvh_t / bvh_s: the rest surfaces. Y must lie on the target
+// surface.
 BoneCorrespondence bone_correspondence(const Eigen::MatrixXd& Y, const std::vector<std::pair<int, int>>& bones,
                                        const Eigen::MatrixXd& Jt, const Eigen::MatrixXd& Js,
                                        const TriangleBvh& bvh_t, const TriangleBvh& bvh_s);

@@ -60,9 +60,25 @@ SingularityResult singularity_points(const Eigen::MatrixXd& V, const Eigen::Matr
   return r;
 }
 
-Status MfsHarmonicMap::build(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+namespace {
+
+// V rounded to a power-of-two grid of ~1e-9 × its bounding-box diagonal. The sampling below is
+// made of discrete choices (farthest points, inside tests), so a last-bit difference of the input
+// (a skinned calibration pose evaluated with another libm, natively vs in wasm) could pick other
+// points and move the result by percents; on the grid both platforms see the same numbers.
+Eigen::MatrixXd snapped_to_grid(const Eigen::MatrixXd& V) {
+  const double diag = bounding_box_diagonal(V);
+  if (!(diag > 0) || !std::isfinite(diag)) return V;
+  const double q = std::ldexp(1.0, static_cast<int>(std::floor(std::log2(1e-9 * diag))));
+  return (V / q).array().round().matrix() * q;
+}
+
+}  // namespace
+
+Status MfsHarmonicMap::build(const Eigen::MatrixXd& V_in, const Eigen::MatrixXi& F,
                              const HarmonicMapOptions& opt, const Progress& progress) {
   if (!progress.update("singularities", 0)) return cancelled_status("singularities");
+  const Eigen::MatrixXd V = snapped_to_grid(V_in);
   SingularityResult sr = singularity_points(V, F, opt.singularities);
   if (!sr.status.ok()) return sr.status;
   Q_ = std::move(sr.Q);

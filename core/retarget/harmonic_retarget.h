@@ -106,6 +106,9 @@ class HarmonicRetargeter {
   const Eigen::Matrix3d& alignment() const { return R_; }       // target axes → source axes
   double anchor_scale() const { return scale_; }                // root-motion scale (target/source)
   int num_descriptor_points() const { return static_cast<int>(Xs_desc_.rows()); }
+  // Descriptor points (working frames: centred, unit bbox diagonal, target rotated) on both sides.
+  const Eigen::MatrixXd& source_descriptors() const { return Xs_desc_; }
+  const Eigen::MatrixXd& target_descriptors() const { return Xt_desc_; }
   const MfsHarmonicMap& source_map() const { return src_map_; }
   const MfsHarmonicMap& target_map() const { return tgt_map_; }
   const std::vector<std::string>& warnings() const { return warnings_; }
