@@ -7,7 +7,7 @@
 //                options?, progress?: (stage, fraction) => boolean, cagePositions?, cageIndices?)
 //     options (C++ field names, missing = default): {method: "yin"|"kovnatsky"|"levy",
 //       num_low_frequencies, num_eigenpairs, lambda1, lambda2, max_iterations, tolerance,
-//       num_coupled, mu, cage_vertices, placement: "reference"|"source"}
+//       num_coupled, mu, cage_vertices, cage_resolution, placement: "reference"|"source"}
 //     → {ok, positions: Float64Array (#V·3), gamma: Float64Array (k·k, row-major), k,
 //        gammaDominance, iterations, converged, couplingIterations, cagePositions: Float64Array,
 //        cageRest: Float64Array, cageIndices: Uint32Array, energy: Float64Array,
@@ -54,6 +54,7 @@ val pose_transfer_js(val ref_positions, val ref_indices, val src_positions, val 
     opt.coupling.num_coupled = get_int(options, "num_coupled", opt.coupling.num_coupled);
     opt.coupling.mu = get_number(options, "mu", opt.coupling.mu);
     opt.cage.target_vertices = get_int(options, "cage_vertices", opt.cage.target_vertices);
+    opt.cage.resolution = get_int(options, "cage_resolution", opt.cage.resolution);
     opt.placement = get_string(options, "placement", "reference") == "source" ? TransferPlacement::Source
                                                                               : TransferPlacement::Reference;
     Mesh cage;

@@ -4,7 +4,7 @@
 //
 // transfer: options {referenceSlot = 'reference', sourceSlot = 'main', landmarks?: [[r, s], ...],
 //   method?: 'yin'|'kovnatsky'|'levy', lambda1?, lambda2?, num_low_frequencies?, num_eigenpairs?,
-//   cage_vertices?, placement?: 'reference'|'source'}
+//   cage_vertices?, cage_resolution?, max_iterations?, placement?: 'reference'|'source'}
 //   → buffers {positions: Float32Array (welded #V·3 of the source), cagePositions, cageIndices}
 //     info {gammaDominance, iterations, converged, couplingIterations, ms, k, gamma: number[]}
 //   Progress messages carry the core's stages (eigenbasis, coupled bases, cage: …,
@@ -35,7 +35,8 @@ export const ops = {
       source.weldedPositions, source.weldedIndices, flatLandmarks(options.landmarks), {
         method: options.method, lambda1: options.lambda1, lambda2: options.lambda2,
         num_low_frequencies: options.num_low_frequencies, num_eigenpairs: options.num_eigenpairs,
-        cage_vertices: options.cage_vertices, placement: options.placement,
+        cage_vertices: options.cage_vertices, cage_resolution: options.cage_resolution,
+        max_iterations: options.max_iterations, placement: options.placement,
       }, (stage, fraction) => ctx.progress(stage, fraction)));
     return {
       buffers: {
