@@ -297,10 +297,13 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
 
 void SupernodalCholesky::solve_in_place(Eigen::MatrixXd& B) const {
   const int k = static_cast<int>(B.cols());
-  Eigen::MatrixXd Y(n_, k);
+  // Row-major work arrays: the gathers and scatters below touch whole rows (k values each), which
+  // are then contiguous instead of k cache lines apart.
+  using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  RowMatrix Y(n_, k);
   for (int i = 0; i < n_; ++i) Y.row(perm_[i]) = B.row(i);
   const int ns = static_cast<int>(start_.size()) - 1;
-  Eigen::MatrixXd tmp;
+  RowMatrix tmp;
   // Forward: L y = b.
   for (int s = 0; s < ns; ++s) {
     const int f = start_[s], ncols = start_[s + 1] - f, nr = rows_ptr_[s + 1] - rows_ptr_[s], m = ncols + nr;
