@@ -834,9 +834,9 @@ EditResult LaplacianEditor::Impl::solve_stage2(bool use_rotations, FeatureSize m
     return solver2.solve(rhs, xx);
   };
   // The same equation with δ_i = Σ_j w_ij (v_i − v_j) rotated edge by edge:
-  // b_i = Σ_j w_ij s_ij R_ij (v_i − v_j) with R_ij the midpoint of R_i and R_j (rotation part of
-  // their mean, the geodesic midpoint for angles < π) and s_ij the mean scale. Equal to T_i δ_i
-  // where T is constant; where it varies, the difference carries the bend of thin parts.
+  // b_i = Σ_j w_ij s_ij R_ij (v_i − v_j) with R_ij the geodesic midpoint of R_i and R_j and s_ij
+  // the mean scale. Equal to T_i δ_i where T is constant; where it varies, the difference carries
+  // the bend of thin parts.
   auto per_edge_rhs = [&](const std::vector<Eigen::Matrix3d>& T, const std::vector<double>& S, Eigen::MatrixXd* bb) {
     std::vector<Eigen::Quaterniond> q(T.size());
     for (size_t l = 0; l < T.size(); ++l) q[l] = Eigen::Quaterniond(T[l]);
@@ -853,56 +853,68 @@ EditResult LaplacianEditor::Impl::solve_stage2(bool use_rotations, FeatureSize m
       bb->row(l) = acc.transpose();
     }
   };
+  const bool per_edge = use_rotations && opt.rotated_coordinates == RotatedCoordinates::PerEdge;
+  std::vector<Eigen::Matrix3d> T;
+  std::vector<double> S;
   if (use_rotations) {
     // Sec. 4: M_i = U W Vᵀ → R_i = U Vᵀ, s_i = sqrt((λ1² + λ2² + λ3²)/3); T_i = R_i (Eq. 9) or
     // R_i S_i (Eq. 10). Constrained vertices (hard or soft) take their handle's similarity, fixed
-    // ones the identity.
-    std::vector<Eigen::Matrix3d> T(opt.rotated_coordinates == RotatedCoordinates::PerEdge ? nL : nU);
-    std::vector<double> S(T.size());
+    // ones the identity (one polar decomposition per handle, not per vertex).
+    auto scale_of = [&](const Eigen::Matrix3d& M) {
+      return mode == FeatureSize::Scale ? std::sqrt(M.squaredNorm() / 3.0) : 1.0;  // Σσ² = ||M||²_F
+    };
+    std::vector<Eigen::Matrix3d> handle_R(num_handles);
+    std::vector<double> handle_s(num_handles);
+    for (int h = 0; h < num_handles; ++h) {
+      handle_R[h] = rotation_part(linear[h]);
+      handle_s[h] = scale_of(linear[h]);
+    }
+    T.resize(per_edge ? nL : nU);
+    S.resize(T.size());
     for (int l = 0; l < static_cast<int>(T.size()); ++l) {
       const int g = group[l];
-      const Eigen::Matrix3d M = g == -2 && center_of[l] >= 0 ? gradient_local(l)  // free unknown
-                                : g >= 0                         ? linear[g]
-                                                                 : Eigen::Matrix3d::Identity();
-      const double s = mode == FeatureSize::Scale ? std::sqrt(M.squaredNorm() / 3.0) : 1.0;  // Σσ² = ||M||²_F
-      T[l] = rotation_part(M);
-      S[l] = s;
+      if (g == -2 && center_of[l] >= 0) {  // free unknown
+        const Eigen::Matrix3d M = gradient_local(l);
+        T[l] = rotation_part(M);
+        S[l] = scale_of(M);
+      } else if (g >= 0) {
+        T[l] = handle_R[g];
+        S[l] = handle_s[g];
+      } else {
+        T[l] = Eigen::Matrix3d::Identity();
+        S[l] = 1.0;
+      }
     }
-    if (opt.rotated_coordinates == RotatedCoordinates::PerVertex) {
+    if (per_edge) {
+      per_edge_rhs(T, S, &b);
+    } else {
       // Eq. 9/10 literally: b_i = T_i δ_i with δ_i = (W v)_i (the row factor of D cancels).
       for (int l = 0; l < nU; ++l) b.row(l) = (S[l] * (T[l] * LC.row(l).transpose())).transpose();
-    } else {
-      per_edge_rhs(T, S, &b);
-    }
-    Status st = solve2(b, &x);
-    // Optional local/global refinement (not in the paper): re-fit each free vertex's rotation to
-    // its finalized 1-ring (cotangent-weighted, rest edges → deformed edges) and solve again.
-    const int refinements = opt.rotated_coordinates == RotatedCoordinates::PerEdge ? opt.finalize_refinements : 0;
-    for (int it = 0; it < refinements && st.ok(); ++it) {
-      for (int l = 0; l < nU; ++l) {
-        if (group[l] != -2) continue;
-        Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-        const Eigen::Vector3d xl = x.row(l).transpose();
-        for (int e = edge_begin[l]; e < edge_begin[l + 1]; ++e) {
-          const int j = edge_end_vertex[e];
-          const Eigen::Vector3d xj = j < nU ? Eigen::Vector3d(x.row(j).transpose()) : Eigen::Vector3d(known.row(j - nU).transpose());
-          A.noalias() += std::abs(edge_weight[e]) * (xl - xj) * edge_rest[e].transpose();
-        }
-        T[l] = rotation_part(A);
-      }
-      per_edge_rhs(T, S, &b);
-      st = solve2(b, &x);
-    }
-    if (!st.ok()) {
-      out.status = st;
-      return out;
     }
   } else {
     b = LC;  // naive Laplacian editing: unrotated Laplacian coordinates
-    if (Status st = solve2(b, &x); !st.ok()) {
-      out.status = st;
-      return out;
+  }
+  Status st = solve2(b, &x);
+  // Optional local/global refinement (not in the paper, PerEdge only): re-fit each free vertex's
+  // rotation to its finalized 1-ring (cotangent-weighted, rest edges → deformed edges), solve again.
+  for (int it = 0; per_edge && it < opt.finalize_refinements && st.ok(); ++it) {
+    for (int l = 0; l < nU; ++l) {
+      if (group[l] != -2) continue;
+      Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+      const Eigen::Vector3d xl = x.row(l).transpose();
+      for (int e = edge_begin[l]; e < edge_begin[l + 1]; ++e) {
+        const int j = edge_end_vertex[e];
+        const Eigen::Vector3d xj = j < nU ? Eigen::Vector3d(x.row(j).transpose()) : Eigen::Vector3d(known.row(j - nU).transpose());
+        A.noalias() += std::abs(edge_weight[e]) * (xl - xj) * edge_rest[e].transpose();
+      }
+      T[l] = rotation_part(A);
     }
+    per_edge_rhs(T, S, &b);
+    st = solve2(b, &x);
+  }
+  if (!st.ok()) {
+    out.status = st;
+    return out;
   }
   out.V = V;
   for (int l = 0; l < nU; ++l) out.V.row(l2g[l]) = x.row(l);
