@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -191,7 +192,7 @@ TEST(RetargetSynthetic, SelfRetargetingBentTubeAndWeightReading) {
     }
     return e;
   };
-  mm::HarmonicRetargetOptions ours;  // λ_smooth = 0.01, λ_position = 10 (the text's principles)
+  mm::HarmonicRetargetOptions ours;  // λ_smooth = 0.001, λ_position = 10 (the text's principles)
   mm::HarmonicRetargetOptions literal = ours;  // the list read in its printed order
   literal.w_smooth = 10;
   literal.w_position = 0.01;
@@ -218,7 +219,8 @@ struct Job {
 
 std::unique_ptr<Job> job(const std::string& src, const std::string& tgt, const std::string& clip, double fps,
                          int last_frame, const std::string& joints_file = "",
-                         mm::io::RetargetMethod method = mm::io::RetargetMethod::Harmonic) {
+                         mm::io::RetargetMethod method = mm::io::RetargetMethod::Harmonic,
+                         const std::function<void(mm::HarmonicRetargetOptions&)>& tweak = {}) {
   auto j = std::make_unique<Job>();
   j->src = mm::io::load_asset(mm::test::data_path(src));
   j->tgt = mm::io::load_asset(mm::test::data_path(tgt));
@@ -238,6 +240,7 @@ std::unique_ptr<Job> job(const std::string& src, const std::string& tgt, const s
   o.fps = fps;
   o.last_frame = last_frame;
   o.method = method;
+  if (tweak) tweak(o.harmonic);
   j->status = j->session.prepare(j->src.asset, j->tgt.asset, joints, "", o);
   return j;
 }
@@ -264,6 +267,15 @@ TEST(RetargetReal, SelfRetargetingCesiumMan) {
   EXPECT_LE(e.mean, 0.01);
 }
 
+// The KayKit characters are six interpenetrating parts (legs and arms buried in the body) that
+// move differently where they touch; one harmonic map over their union fits them less well than
+// a single skin (docs/retarget.md, "Why KayKit needs a larger budget").
+void larger_budget(mm::HarmonicRetargetOptions& h) {
+  h.map.singularities.count = 600;
+  h.map.num_collocation = 2500;
+  h.w_bone = 0.3;
+}
+
 TEST(RetargetReal, SelfRetargetingKayKitKnight) {
   auto j = job("anim/KayKit/Knight.glb", "anim/KayKit/Knight.glb", "Walking_A", 10, -1);
   ASSERT_TRUE(j->status.ok()) << j->status.message;
@@ -273,11 +285,20 @@ TEST(RetargetReal, SelfRetargetingKayKitKnight) {
   EXPECT_LT((H.source_descriptors() - H.target_descriptors()).cwiseAbs().maxCoeff(), 1e-12);
   const mm::SequenceError e = self_error(*j);
   RecordProperty("mean_error_over_height", std::to_string(e.mean));
-  std::cout << "[ Knight self-retargeting ] mean " << e.mean << " max frame " << e.max << " of height\n";
-  // Known gap: 0.015 of the height, above the 0.01. The MFS fit alone (Eq. 13, 260
-  // singularities) of the 6 interpenetrating parts is 0.011 (see docs/retarget.md). Guarded
-  // here against regressions.
-  EXPECT_LE(e.mean, 0.017);
+  std::cout << "[ Knight self-retargeting, paper budget ] mean " << e.mean << " max frame " << e.max << " of height\n";
+  // With the paper's 260 singularities the MFS fit alone (Eq. 13) of the six parts is 0.011 of
+  // the height, so the 0.01 is out of reach here (0.014 measured); regression guard.
+  EXPECT_LE(e.mean, 0.015);
+  // 600 singularities, 2500 collocation points and λ_bone = 0.3 (bone lengths held less
+  // stiffly: the harmonic map's interior at the joints does not follow the skeleton exactly).
+  auto b = job("anim/KayKit/Knight.glb", "anim/KayKit/Knight.glb", "Walking_A", 10, -1, "",
+               mm::io::RetargetMethod::Harmonic, larger_budget);
+  ASSERT_TRUE(b->status.ok()) << b->status.message;
+  const mm::SequenceError eb = self_error(*b);
+  RecordProperty("mean_error_over_height_larger_budget", std::to_string(eb.mean));
+  std::cout << "[ Knight self-retargeting, 600 singularities ] mean " << eb.mean << " max frame " << eb.max
+            << " of height\n";
+  EXPECT_LE(eb.mean, 0.01);
 }
 
 TEST(RetargetReal, SelfRetargetingKayKitBarbarian) {
@@ -286,8 +307,8 @@ TEST(RetargetReal, SelfRetargetingKayKitBarbarian) {
   const mm::SequenceError e = self_error(*j);
   RecordProperty("mean_error_over_height", std::to_string(e.mean));
   std::cout << "[ Barbarian self-retargeting ] mean " << e.mean << " max frame " << e.max << " of height\n";
-  // Same known gap as the Knight (fit alone 0.010): regression guard.
-  EXPECT_LE(e.mean, 0.017);
+  // Same gap as the Knight at the paper's budget (0.013 measured): regression guard.
+  EXPECT_LE(e.mean, 0.015);
 }
 
 TEST(RetargetReal, KnightToBarbarianHarmonicVsLbs) {
@@ -344,7 +365,7 @@ TEST(RetargetReal, MultiPartRobotExpressive) {
   const mm::SequenceError e = self_error(*j);
   std::cout << "[ RobotExpressive self-retargeting ] mean " << e.mean << " of height\n";
   EXPECT_TRUE(std::isfinite(e.mean));
-  EXPECT_LT(e.mean, 0.025);
+  EXPECT_LT(e.mean, 0.015);
 }
 
 TEST(RetargetReal, ClipNotFoundListsClips) {
@@ -385,4 +406,5 @@ TEST(RetargetGolden, KnightToBarbarianFrames) {
     for (int i = 0; i < n; ++i) G.row(f * n + i) = frames[f].row(std::min<int>(i * 37, frames[f].rows() - 1));
   mm::test::expect_golden("retarget_knight_barbarian", G, 1e-3);
 }
+
 

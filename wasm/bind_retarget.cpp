@@ -8,7 +8,7 @@
 //                   clip, targetPositions: Float32Array (#V·3 rest surface), targetIndices:
 //                   Uint32Array, warnings: string[]}
 //     options: {clip, fps, first_frame, last_frame, method: "harmonic"|"lbs",
-//               num_singularities, offset, w_affine, w_position, w_smooth, w_bone,
+//               num_singularities, num_collocation, offset, w_affine, w_position, w_smooth, w_bone,
 //               bone_iterations, surface_descriptors, anchor_joint}
 //   retargetFrames(session, first, count, progress?) → {ok, positions: Float32Array
 //                   (count·#V·3, frame-major)}; progress returning false cancels (Cancelled)
@@ -63,6 +63,7 @@ emscripten::val retarget_prepare(emscripten::val src, std::string src_name, emsc
   HarmonicRetargetOptions& h = o.harmonic;
   h.map.singularities.count = get_int(options, "num_singularities", h.map.singularities.count);
   h.map.singularities.offset = get_number(options, "offset", h.map.singularities.offset);
+  h.map.num_collocation = get_int(options, "num_collocation", h.map.num_collocation);
   h.w_affine = get_number(options, "w_affine", h.w_affine);
   h.w_position = get_number(options, "w_position", h.w_position);
   h.w_smooth = get_number(options, "w_smooth", h.w_smooth);

@@ -118,14 +118,18 @@ Status MfsHarmonicMap::build(const Eigen::MatrixXd& V_in, const Eigen::MatrixXi&
   rank_ = 0;
   while (rank_ < sv.size() && sv[rank_] > cut) ++rank_;
   const Eigen::VectorXd inv = sv.head(rank_).cwiseInverse();
-  pinv_ = svd.matrixV().leftCols(rank_) * inv.asDiagonal() * svd.matrixU().leftCols(rank_).transpose();
-  if (!pinv_.allFinite()) return Status::error(StatusCode::NumericalError, "MFS pseudo-inverse is not finite");
+  U_ = svd.matrixU().leftCols(rank_);
+  VSinv_ = svd.matrixV().leftCols(rank_) * inv.asDiagonal();
+  if (!U_.allFinite() || !VSinv_.allFinite())
+    return Status::error(StatusCode::NumericalError, "MFS pseudo-inverse is not finite");
   progress.update("svd", 1);
   return Status::success();
 }
 
+Eigen::MatrixXd MfsHarmonicMap::project(const Eigen::MatrixXd& B) const { return transposed_times_n3(U_, B); }
+
 Eigen::MatrixXd MfsHarmonicMap::fit(const Eigen::MatrixXd& V_deformed) const {
-  return pinv_ * colloc_.positions(V_deformed, F_);
+  return fit_collocation(colloc_.positions(V_deformed, F_));
 }
 
 }  // namespace mm

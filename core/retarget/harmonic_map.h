@@ -63,7 +63,15 @@ class MfsHarmonicMap {
     return colloc_.positions(V_deformed, F_);
   }
   // The same from the deformed collocation positions (N_c by 3) directly.
-  Eigen::MatrixXd fit_collocation(const Eigen::MatrixXd& B) const { return pinv_ * B; }
+  Eigen::MatrixXd fit_collocation(const Eigen::MatrixXd& B) const { return from_projection(project(B)); }
+
+  // As⁺ = V S⁻¹ Uᵀ is kept factored (rank r ≤ N_a): project(B) = Uᵀ B (r by 3) and
+  // Ws = from_projection(Y) = V S⁻¹ Y. Callers that apply a fixed linear map M after the fit
+  // precompute M V S⁻¹ (coefficient_map()) and work on the r-dimensional projection; the fit's
+  // collocation residual is then ‖B‖² − ‖Uᵀ B‖² (As Ws = U Uᵀ B is an orthogonal projection).
+  Eigen::MatrixXd project(const Eigen::MatrixXd& B) const;
+  Eigen::MatrixXd from_projection(const Eigen::MatrixXd& Y) const { return VSinv_ * Y; }
+  const Eigen::MatrixXd& coefficient_map() const { return VSinv_; }  // N_a by r: V S⁻¹
 
   const Eigen::MatrixXd& singularities() const { return Q_; }   // N_a by 3
   const SurfaceSamples& collocation() const { return colloc_; }  // N_c samples
@@ -75,7 +83,8 @@ class MfsHarmonicMap {
   Eigen::MatrixXd Q_;
   SurfaceSamples colloc_;
   Eigen::MatrixXi F_;
-  Eigen::MatrixXd pinv_;  // N_a by N_c
+  Eigen::MatrixXd U_;      // N_c by r: U of the truncated SVD of As
+  Eigen::MatrixXd VSinv_;  // N_a by r: V S⁻¹
   int rank_ = 0;
   double condition_ = 0;
 };

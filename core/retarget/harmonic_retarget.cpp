@@ -218,11 +218,10 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
   if (!progress.update("synthesis", 0.8)) return cancelled_status("synthesis");
   const Eigen::MatrixXd& Q = src_map_.singularities();
   const Eigen::MatrixXd& U = tgt_map_.singularities();
-  Ds_desc_ = mfs_gradient(Xs_desc_, Q);
+  const Eigen::MatrixXd Ds_desc = mfs_gradient(Xs_desc_, Q);
   Ks_joints_ = mfs_kernel(Js_rest_, Q);
-  As_ = mfs_kernel(src_map_.collocation().P, Q);
   Kt_joints_ = mfs_kernel(Jt_rest_, U);
-  Kt_all_ = mfs_kernel(Xt, U);
+  KtT_all_ = mfs_kernel(Xt, U).transpose();
 
   synth_ = HarmonicSynthesis();
   const int nd = static_cast<int>(Xt_desc_.rows());
@@ -254,6 +253,28 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
   }
   s = synth_.factor(opt.ridge);
   if (!s.ok()) return s;
+  // Per-frame operators. Everything but the bone directions is linear in the projection
+  // Ys = Uᵀ bs of the source frame (harmonic_map.h): Ws = V S⁻¹ Ys, Jsᵀ = Ds Ws, and
+  // Wt = Ga Ys + gp p_anchor + Gb d̂ with Ga = N⁻¹ w_a A_aᵀ Ds V S⁻¹ (Eq. 13, 14, 18 composed).
+  // The bone re-linearisation only needs the target joints, Kt_joints Wt, so it runs on
+  // #joints-row products; V = Kt Wt (Eq. 6) is formed once at the end.
+  {
+    const Eigen::MatrixXd& VSinv = src_map_.coefficient_map();
+    KsJ_ = Ks_joints_ * VSinv;
+    Ga_ = synth_.solution_operator(term_affine_, Ds_desc * VSinv);
+    gp_ = synth_.solution_operator(term_position_);
+    KtGa_ = Kt_joints_ * Ga_;
+    Ktgp_ = Kt_joints_ * gp_;
+    if (term_bone_ >= 0) {
+      Gb_ = synth_.solution_operator(term_bone_);
+      KtGb_ = Kt_joints_ * Gb_;
+    } else {
+      Gb_.resize(U.rows(), 0);
+      KtGb_.resize(Kt_joints_.rows(), 0);
+    }
+    if (!Ga_.allFinite() || !gp_.allFinite() || !Gb_.allFinite())
+      return Status::error(StatusCode::NumericalError, "synthesis operators are not finite");
+  }
   progress.update("synthesis", 1.0);
   ready_ = true;
   return Status::success();
@@ -269,13 +290,15 @@ RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) cons
     out.status = Status::error(StatusCode::InvalidArgument, "source frame must be #V by 3 finite positions");
     return out;
   }
-  // Analysis: Ws = As⁺ bs (Eq. 13); Jsᵀ = Ds Ws at every descriptor point (Eq. 4, 14).
+  // Analysis: Ws = As⁺ bs (Eq. 13) in its factored form, Ys = Uᵀ bs and Ws = V S⁻¹ Ys; the
+  // source joints f_s(J_s) = Ks Ws (Eq. 2) and the Jacobians Jsᵀ = Ds Ws (Eq. 4, 14) enter
+  // through the precomposed operators.
   const Eigen::MatrixXd Xs = retarget_detail::to_working(V_source, cs_, Ls_, Eigen::Matrix3d::Identity());
   const Eigen::MatrixXd bs = src_map_.collocation_positions(Xs);
-  const Eigen::MatrixXd Ws = src_map_.fit_collocation(bs);
-  out.fit_residual = std::sqrt((As_ * Ws - bs).squaredNorm() / std::max<Eigen::Index>(1, bs.rows()));
-  const Eigen::MatrixXd JsT = Ds_desc_ * Ws;          // 3m by 3, blocks Jᵀ
-  const Eigen::MatrixXd Js_now = Ks_joints_ * Ws;     // f_s at the used source joints
+  const Eigen::MatrixXd Ys = src_map_.project(bs);
+  out.fit_residual = std::sqrt(std::max(0.0, bs.squaredNorm() - Ys.squaredNorm()) /
+                               std::max<Eigen::Index>(1, bs.rows()));
+  const Eigen::MatrixXd Js_now = KsJ_ * Ys;  // f_s at the used source joints
 
   // E_position: the anchor follows the source anchor's displacement, scaled (leg-length ratio).
   const Eigen::MatrixXd p_anchor =
@@ -296,28 +319,29 @@ RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) cons
     else
       dirs.row(b) = t0.transpose();
   }
-  std::vector<const Eigen::MatrixXd*> rhs(synth_.num_terms(), nullptr);
-  rhs[term_affine_] = &JsT;
-  rhs[term_position_] = &p_anchor;
-  if (term_bone_ >= 0) rhs[term_bone_] = &dirs;
-  Eigen::MatrixXd Wt;
-  const int iterations = term_bone_ >= 0 ? 1 + std::max(0, opt_.bone_iterations) : 1;
-  for (int it = 0; it < iterations; ++it) {
-    out.status = synth_.solve(rhs, &Wt);
-    if (!out.status.ok()) return out;
-    if (it + 1 == iterations) break;
-    // Re-linearise Eq. 9 around the current joints: keep each bone's direction, restore its length.
-    const Eigen::MatrixXd Jt_now = Kt_joints_ * Wt;
+  // Eq. 18 with the bone term re-linearised around the current target joints (keep each bone's
+  // direction, restore its length); only the joints are needed until the last solve.
+  const Eigen::MatrixXd Jt_fixed = KtGa_ * Ys + Ktgp_ * p_anchor;  // joints without the bone term
+  Eigen::MatrixXd Jt_now = nb > 0 ? Eigen::MatrixXd(Jt_fixed + KtGb_ * dirs) : Jt_fixed;
+  const int relinearisations = nb > 0 ? std::max(0, opt_.bone_iterations) : 0;
+  for (int it = 0; it < relinearisations; ++it) {
     for (int b = 0; b < nb; ++b) {
       const Eigen::RowVector3d d = Jt_now.row(bones_[b].first) - Jt_now.row(bones_[b].second);
       if (d.norm() > 1e-12) dirs.row(b) = d / d.norm();
     }
+    Jt_now = Jt_fixed + KtGb_ * dirs;
+  }
+  Eigen::MatrixXd Wt = Ga_ * Ys + gp_ * p_anchor;
+  if (nb > 0) Wt.noalias() += Gb_ * dirs;
+  if (!Wt.allFinite()) {
+    out.status = Status::error(StatusCode::NumericalError, "synthesized coefficients are not finite");
+    return out;
   }
   // Eq. 6: V = Kt Wt for every target vertex, back to target units and axes.
-  const Eigen::MatrixXd Vw = Kt_all_ * Wt;
+  const Eigen::MatrixXd Vw = transposed_times_n3(KtT_all_, Wt);
   out.V = (Vw * R_) * Lt_;
   out.V.rowwise() += ct_;
-  out.joints = ((Kt_joints_ * Wt) * R_) * Lt_;
+  out.joints = (Jt_now * R_) * Lt_;
   out.joints.rowwise() += ct_;
   out.source_joints = Js_now * Ls_;
   out.source_joints.rowwise() += cs_;

@@ -63,7 +63,10 @@ struct HarmonicRetargetOptions {
   HarmonicMapOptions map;       // MFS of both calibration shapes (singularities, collocation, SVD)
   double w_affine = 1.0;        // λ_affine: Jacobian match at descriptor points (reference weight)
   double w_position = 10.0;     // λ_position: anchor trajectory; "should be with a large weight"
-  double w_smooth = 0.01;       // λ_smooth: Hessian energy; "should be small, otherwise flattened"
+  double w_smooth = 0.001;      // λ_smooth: Hessian energy; "should be small, otherwise flattened".
+                                // The list's 0.01 was our first default; 0.001 lowered every measured
+                                // error (self-retargeting, Knight → Barbarian, Fox bone lengths) and
+                                // still keeps λ_smooth = 10 apart as flattening (docs/retarget.md)
   double w_bone = 1.0;          // λ_bone: bone-length preservation
   int bone_iterations = 2;      // re-linearisations of E_bone after the first solve (0 = one solve)
   int bone_samples = 1;         // descriptor points inside each bone besides its ends (0 = joints only, as in the paper)
@@ -127,11 +130,13 @@ class HarmonicRetargeter {
   Eigen::Matrix3d R_ = Eigen::Matrix3d::Identity();
   MfsHarmonicMap src_map_, tgt_map_;
   Eigen::MatrixXd Xs_desc_, Xt_desc_;   // descriptor points (working frames)
-  Eigen::MatrixXd Ds_desc_;             // 3m by N_a(source)
   Eigen::MatrixXd Ks_joints_;           // #used by N_a(source)
-  Eigen::MatrixXd As_;                  // N_c by N_a(source), for the fit residual
   Eigen::MatrixXd Kt_joints_;           // #used by N_a(target)
-  Eigen::MatrixXd Kt_all_;              // #V_target by N_a(target)
+  // Per-frame operators (see precompute): r = rank of the source's As.
+  Eigen::MatrixXd KsJ_;                 // #used by r: source joints from Ys
+  Eigen::MatrixXd Ga_, gp_, Gb_;        // N_a(target) by r, 1, #bones
+  Eigen::MatrixXd KtGa_, Ktgp_, KtGb_;  // the same mapped to the target joints
+  Eigen::MatrixXd KtT_all_;             // N_a(target) by #V_target: Ktᵀ (see transposed_times_n3)
   Eigen::MatrixXd Js_rest_, Jt_rest_;   // used joints, working frames
   std::vector<std::pair<int, int>> bone_desc_;  // descriptor indices of each bone's ends
   Eigen::VectorXd rest_len_;            // target bone lengths, working units

@@ -64,6 +64,14 @@ Status HarmonicSynthesis::solve(const std::vector<const Eigen::MatrixXd*>& B, Ei
   return Status::success();
 }
 
+Eigen::MatrixXd HarmonicSynthesis::solution_operator(int k, const Eigen::MatrixXd& M) const {
+  assert(factored_ && k >= 0 && k < num_terms());
+  const SynthesisTerm& t = terms_[k];
+  if (M.size() == 0) return impl_->llt.solve(t.weight * t.A.transpose());
+  assert(M.rows() == t.A.rows());
+  return impl_->llt.solve(t.weight * (t.A.transpose() * M));
+}
+
 std::vector<double> HarmonicSynthesis::energies(const std::vector<const Eigen::MatrixXd*>& B,
                                                 const Eigen::MatrixXd& W) const {
   std::vector<double> e;

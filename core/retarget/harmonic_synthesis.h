@@ -52,6 +52,12 @@ class HarmonicSynthesis {
   // nullptr or empty for zero_rhs terms. NumericalError when the result is not finite.
   Status solve(const std::vector<const Eigen::MatrixXd*>& B, Eigen::MatrixXd* W) const;
 
+  // The solution is linear in each right-hand side: Wt = Σ_k N⁻¹ w_k A_kᵀ B_k. When B_k = M_k y
+  // for a fixed M_k (rows_k by c) and a per-frame y, the operator N⁻¹ w_k A_kᵀ M_k (N_a by c)
+  // can be formed once and each frame costs one small product (HarmonicRetargeter does this).
+  // M = empty means the identity (returns N⁻¹ w_k A_kᵀ).
+  Eigen::MatrixXd solution_operator(int k, const Eigen::MatrixXd& M = Eigen::MatrixXd()) const;
+
   // Value of Σ w_k ‖A_k W − B_k‖² per term (diagnostics and tests).
   std::vector<double> energies(const std::vector<const Eigen::MatrixXd*>& B, const Eigen::MatrixXd& W) const;
 

@@ -1,6 +1,7 @@
 #include "retarget/mfs_kernel.h"
 
 #include <cmath>
+#include <vector>
 
 namespace mm {
 
@@ -51,6 +52,37 @@ Eigen::MatrixXd mfs_hessian(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Q) 
       H(6 * i + 5, a) = s2 * c * t * d[1] * d[2];
     }
   return H;
+}
+
+Eigen::MatrixXd transposed_times_n3(const Eigen::MatrixXd& Mt, const Eigen::MatrixXd& B) {
+  const Eigen::Index k = Mt.rows(), n = Mt.cols();
+  std::vector<double> b(3 * k);  // B row-major
+  for (Eigen::Index i = 0; i < k; ++i)
+    for (int c = 0; c < 3; ++c) b[3 * i + c] = B(i, c);
+  Eigen::MatrixXd out(n, 3);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double* m = Mt.col(j).data();
+    double x0 = 0, y0 = 0, z0 = 0, x1 = 0, y1 = 0, z1 = 0;  // two chains for instruction-level parallelism
+    Eigen::Index i = 0;
+    for (; i + 1 < k; i += 2) {
+      const double* p = &b[3 * i];
+      x0 += m[i] * p[0];
+      y0 += m[i] * p[1];
+      z0 += m[i] * p[2];
+      x1 += m[i + 1] * p[3];
+      y1 += m[i + 1] * p[4];
+      z1 += m[i + 1] * p[5];
+    }
+    if (i < k) {
+      x0 += m[i] * b[3 * i];
+      y0 += m[i] * b[3 * i + 1];
+      z0 += m[i] * b[3 * i + 2];
+    }
+    out(j, 0) = x0 + x1;
+    out(j, 1) = y0 + y1;
+    out(j, 2) = z0 + z1;
+  }
+  return out;
 }
 
 }  // namespace mm

@@ -24,4 +24,11 @@ Eigen::MatrixXd mfs_gradient(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Q)
 // norm of H.middleRows(6i, 6)·W equals Σ_c ‖Hessian of f_c at X_i‖²_F (paper 002 Eq. 7).
 Eigen::MatrixXd mfs_hessian(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Q);
 
+// Mtᵀ B for Mt (k by n) and B (k by 3): the per-frame products of the retargeting (V = Kt Wt,
+// Uᵀ bs) with the big operand stored transposed, so that each output row reads one contiguous
+// column. A plain loop with a fixed summation order: for three right-hand columns it is faster
+// than a general matrix product (no packing of the big operand on every call), natively and in
+// WebAssembly without SIMD, and both platforms sum in the same order.
+Eigen::MatrixXd transposed_times_n3(const Eigen::MatrixXd& Mt, const Eigen::MatrixXd& B);
+
 }  // namespace mm

@@ -28,8 +28,9 @@ OUT with .obj/.ply/.off writes one mesh file per frame (OUT_0000.obj, ...).
   --fps F                  sampling rate of the clip (default 30)
   --method harmonic|lbs    harmonic map (default) or the naive LBS baseline (Fig. 6 f)
   --num-singularities N    MFS singularity points per character (default 260)
+  --num-collocation N      MFS collocation points per character (default 1500)
   --offset X               offset surface distance, × bbox diagonal (default 0.04)
-  --w-position, --w-smooth, --w-bone, --w-affine   energy weights (defaults 10, 0.01, 1, 1)
+  --w-position, --w-smooth, --w-bone, --w-affine   energy weights (defaults 10, 0.001, 1, 1)
   --bone-iterations N      re-linearisations of the bone-length term (default 2)
   --surface-descriptors N  target surface points with affine descriptors (default 400; 0 = joints only)
   --anchor-joint NAME      joint whose (scaled) trajectory the target follows (default: shallowest)
@@ -77,6 +78,7 @@ int run_retarget(const std::vector<std::string>& argv) {
   HarmonicRetargetOptions& h = opt.harmonic;
   h.map.singularities.count = args.get_int("num-singularities", h.map.singularities.count, &s);
   h.map.singularities.offset = args.get_double("offset", h.map.singularities.offset, &s);
+  h.map.num_collocation = args.get_int("num-collocation", h.map.num_collocation, &s);
   h.w_position = args.get_double("w-position", h.w_position, &s);
   h.w_smooth = args.get_double("w-smooth", h.w_smooth, &s);
   h.w_bone = args.get_double("w-bone", h.w_bone, &s);
