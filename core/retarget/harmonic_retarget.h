@@ -19,7 +19,8 @@
 //   depend on sample counts.
 // - Weights (Sec. 7.2 lists 0.01, 10, 1, 0.8, 1 for position, smooth, bone, spatial, volume,
 //   while its text says position must be large and smoothness small): we follow the text and
-//   read the list as smooth = 0.01, position = 10 (tests compare both readings).
+//   read the list as smooth small, position = 10 (tests compare both readings); smooth = 0.001
+//   rather than the list's 0.01 because it lowered every measured error (docs/retarget.md).
 // - Position (Eq. 8, "any point, e.g. v1"): the anchor is a joint (default: the shallowest
 //   used joint in the source hierarchy, i.e. the hips/root), and its trajectory is the source
 //   anchor's displacement f_s(a_s) − a_s scaled by the ratio of anchor heights above the
