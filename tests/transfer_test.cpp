@@ -4,7 +4,10 @@
 // inputs and cancellation.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <string>
 
+#include <Eigen/Geometry>
 
 #include "io/asset.h"
 #include "metrics/transfer_metrics.h"
@@ -60,24 +63,79 @@ TEST(TransferSelf, ReferenceEqualsSourceGivesSource) {
   EXPECT_EQ(r.landmarks.size(), 30u);
 }
 
-TEST(TransferPose, PaperMethodBeatsBaselinesOnCat07) {
-  const auto s = transfer_test::score_pair("pose/cat-07.ply", "pose/cat-reference.ply");
+// Same-connectivity pairs with exact ground truth (docs/transfer.md has the table). The paper's
+// method must beat both coefficient-swap baselines on pose error and on detail preservation.
+struct PosePair {
+  const char* pose;
+  const char* rest;
+  double max_error;  // measured value + margin (native Release, 450-vertex cage)
+};
+
+class TransferPose : public testing::TestWithParam<PosePair> {};
+
+TEST_P(TransferPose, PaperMethodBeatsBothBaselines) {
+  const PosePair& p = GetParam();
+  const auto s = transfer_test::score_pair(p.pose, p.rest);
   ASSERT_EQ(s.size(), 3u);
   EXPECT_LT(s[0].error, s[1].error) << "Yin vs Kovnatsky pose error";
   EXPECT_LT(s[0].error, s[2].error) << "Yin vs Lévy pose error";
   EXPECT_LT(s[0].detail, s[1].detail) << "Yin vs Kovnatsky detail";
   EXPECT_LT(s[0].detail, s[2].detail) << "Yin vs Lévy detail";
-  EXPECT_LT(s[0].error, 0.12);
+  EXPECT_LT(s[0].error, p.max_error);
 }
 
-TEST(TransferPose, PaperMethodBeatsBaselinesOnLion05) {
-  const auto s = transfer_test::score_pair("pose/lion-05.ply", "pose/lion-reference.ply");
+INSTANTIATE_TEST_SUITE_P(TransferPairs, TransferPose,
+                         testing::Values(PosePair{"pose/cat-07.ply", "pose/cat-reference.ply", 0.12},
+                                         PosePair{"pose/lion-05.ply", "pose/lion-reference.ply", 0.05},
+                                         PosePair{"pose/cat-05.ply", "pose/cat-reference.ply", 0.066},
+                                         PosePair{"pose/lion-01.ply", "pose/lion-reference.ply", 0.083}),
+                         [](const testing::TestParamInfo<PosePair>& info) {
+                           std::string n = info.param.pose;
+                           n = n.substr(n.find('/') + 1);
+                           n = n.substr(0, n.find('.'));
+                           n.erase(std::remove(n.begin(), n.end(), '-'), n.end());
+                           return n;
+                         });
+
+// cat-01 (large hip rotation): the one pair where Kovnatsky's coefficient swap has the lower pose
+// error (0.056 vs 0.068). It is not a local minimum of Eq. 12: starting the cage solve from the
+// ground truth fitted in the cage subspace, or from the Kovnatsky result, returns to the same
+// minimum (docs/transfer.md). Yin still beats Lévy on error and both baselines on detail.
+TEST(TransferPoseCat01, BeatsLevyAndKeepsDetail) {
+  const auto s = transfer_test::score_pair("pose/cat-01.ply", "pose/cat-reference.ply");
   ASSERT_EQ(s.size(), 3u);
-  EXPECT_LT(s[0].error, s[1].error);
-  EXPECT_LT(s[0].error, s[2].error);
-  EXPECT_LT(s[0].detail, s[1].detail);
-  EXPECT_LT(s[0].detail, s[2].detail);
-  EXPECT_LT(s[0].error, 0.08);
+  EXPECT_LT(s[0].error, s[2].error) << "Yin vs Lévy pose error";
+  EXPECT_LT(s[0].detail, s[1].detail) << "Yin vs Kovnatsky detail";
+  EXPECT_LT(s[0].detail, s[2].detail) << "Yin vs Lévy detail";
+  EXPECT_LT(s[0].error, 0.075);
+}
+
+// cage_pose_energy (exact Procrustes similarities): zero regularity terms for similarities of the
+// rest cage, (s − 1)² per vertex for a uniform scale, ‖P C − T‖² for the data term.
+TEST(TransferCageEnergy, ExactSimilarityTerms) {
+  CagePoseProblem prob;
+  prob.C.resize(6, 3);
+  prob.C << 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1;
+  prob.CF.resize(8, 3);
+  prob.CF << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;
+  prob.P.resize(2, 6);
+  prob.P << 0.3, 0.1, 0.2, 0.2, 0.1, 0.1, 0.5, -0.2, 0.1, 0.3, 0.2, 0.1;
+  prob.T.resize(2, 3);
+  prob.T << 0.1, 0.2, 0.3, -0.1, 0.0, 0.4;
+  const CagePoseEnergy rest = cage_pose_energy(prob, prob.C);
+  EXPECT_NEAR(rest.lf, (prob.P * prob.C - prob.T).squaredNorm(), 1e-14);
+  EXPECT_NEAR(rest.lc, 0, 1e-24);
+  EXPECT_NEAR(rest.sf, 0, 1e-24);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::MatrixXd moved = (prob.C * R.transpose()).rowwise() + Eigen::RowVector3d(0.3, -1, 2);
+  const CagePoseEnergy rigid = cage_pose_energy(prob, moved);
+  EXPECT_NEAR(rigid.lc, 0, 1e-20);
+  EXPECT_NEAR(rigid.sf, 0, 1e-20);
+  const CagePoseEnergy scaled = cage_pose_energy(prob, 1.1 * moved);
+  EXPECT_NEAR(scaled.lc, 0, 1e-20);
+  EXPECT_NEAR(scaled.sf, 6 * 0.01, 1e-12);
+  const CagePoseOptions opt;
+  EXPECT_NEAR(scaled.total, scaled.lf + opt.lambda1 * scaled.lc + opt.lambda2 * scaled.sf, 1e-14);
 }
 
 TEST(TransferDifferentConnectivity, CatToLionGoldenAndDeterministic) {

@@ -89,6 +89,8 @@ CagePoseResult solve_cage_pose(const CagePoseProblem& problem, const CagePoseOpt
   };
   const double w1 = std::sqrt(opt.lambda1), w2 = std::sqrt(opt.lambda2);
   std::vector<LocalFit> fit(m);
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> pre;
+  std::vector<int> pattern_outer, pattern_inner;
 
   for (int it = 0; it < opt.max_iterations; ++it) {
     if (!progress.update("optimisation", double(it) / opt.max_iterations)) {
@@ -134,7 +136,7 @@ CagePoseResult solve_cage_pose(const CagePoseProblem& problem, const CagePoseOpt
     }
     Eigen::SparseMatrix<double> J(4 * m, n);
     J.setFromTriplets(jt.begin(), jt.end());
-    Eigen::SparseMatrix<double> S = (J.transpose() * J).pruned();
+    Eigen::SparseMatrix<double> S = J.transpose() * J;  // same pattern every iteration (see below)
     Eigen::VectorXd b = J.transpose() * r0;
     for (int j = 0; j < m; ++j)
       for (int c = 0; c < 3; ++c) b[3 * j + c] += PtT(j, c);
@@ -151,7 +153,17 @@ CagePoseResult solve_cage_pose(const CagePoseProblem& problem, const CagePoseOpt
     Eigen::SparseMatrix<double> Sreg = S;
     const double eps = 1e-9 * std::max(mean_diag, 1e-300);
     for (int d = 0; d < n; ++d) Sreg.coeffRef(d, d) += eps;
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> pre(Sreg);
+    // The pattern of S (the cage's two-ring) rarely changes between iterations: the ordering and
+    // symbolic analysis are redone only when it does.
+    const bool same_pattern = it > 0 && static_cast<size_t>(Sreg.nonZeros()) == pattern_inner.size() &&
+                              std::equal(Sreg.outerIndexPtr(), Sreg.outerIndexPtr() + n + 1, pattern_outer.begin()) &&
+                              std::equal(Sreg.innerIndexPtr(), Sreg.innerIndexPtr() + Sreg.nonZeros(), pattern_inner.begin());
+    if (!same_pattern) {
+      pre.analyzePattern(Sreg);
+      pattern_outer.assign(Sreg.outerIndexPtr(), Sreg.outerIndexPtr() + n + 1);
+      pattern_inner.assign(Sreg.innerIndexPtr(), Sreg.innerIndexPtr() + Sreg.nonZeros());
+    }
+    pre.factorize(Sreg);
     if (pre.info() != Eigen::Success) {
       out.status = Status::error(StatusCode::FactorizationFailed, "cage pose: factorization of the cage system failed");
       return out;
@@ -225,6 +237,36 @@ CagePoseResult solve_cage_pose(const CagePoseProblem& problem, const CagePoseOpt
     for (int c = 0; c < 3; ++c) out.C(j, c) = x[3 * j + c];
   progress.update("optimisation", 1.0);
   return out;
+}
+
+CagePoseEnergy cage_pose_energy(const CagePoseProblem& problem, const Eigen::MatrixXd& X, const CagePoseOptions& opt) {
+  CagePoseEnergy e;
+  const int m = static_cast<int>(problem.C.rows());
+  if (X.rows() != m || X.cols() != 3 || problem.P.cols() != m) return e;
+  const auto adj = vertex_adjacency(problem.CF, m);
+  e.lf = (problem.P * X - problem.T).squaredNorm();
+  for (int i = 0; i < m; ++i) {
+    if (adj[i].empty()) continue;
+    Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+    double n0 = 0;
+    Eigen::Vector3d mean0 = Eigen::Vector3d::Zero(), mean1 = Eigen::Vector3d::Zero();
+    for (int k : adj[i]) {
+      const Eigen::Vector3d e0 = (problem.C.row(k) - problem.C.row(i)).transpose();
+      const Eigen::Vector3d e1 = (X.row(k) - X.row(i)).transpose();
+      M += e1 * e0.transpose();
+      n0 += e0.squaredNorm();
+      mean0 += problem.C.row(k).transpose();
+      mean1 += X.row(k).transpose();
+    }
+    const Eigen::Matrix3d R = polar_decomposition(M).R;
+    const double s = (R.transpose() * M).trace() / std::max(n0, 1e-300);
+    const Eigen::Vector3d d0 = problem.C.row(i).transpose() - mean0 / adj[i].size();
+    const Eigen::Vector3d d1 = X.row(i).transpose() - mean1 / adj[i].size();
+    e.lc += (s * R * d0 - d1).squaredNorm();
+    e.sf += (s - 1) * (s - 1);
+  }
+  e.total = e.lf + opt.lambda1 * e.lc + opt.lambda2 * e.sf;
+  return e;
 }
 
 }  // namespace mm

@@ -1,6 +1,9 @@
 #include "transfer/pose_transfer.h"
 
+#include <atomic>
 #include <chrono>
+#include <future>
+#include <mutex>
 #include <algorithm>
 #include <cmath>
 
@@ -111,6 +114,102 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
   if (!(out.status = normalize(reference, "reference", &ref)).ok()) return out;
   if (!(out.status = normalize(source, "source", &src)).ok()) return out;
 
+  // 4–5. Cage and mean-value coordinates (Yin only). They depend on the source alone, so natively
+  // they run on a second thread while the eigenbases and the coupling are computed (the results
+  // are the same either way; in WebAssembly, built without threads, they run in sequence below).
+  // Progress of the cage thread: recorded while this thread still computes its own stages, then
+  // forwarded (serialised by a mutex, fractions kept monotone) once this thread only waits for it.
+  struct CageStage {
+    Status status;
+    Eigen::MatrixXd C, Cn, Psi;
+    Eigen::MatrixXi CF;
+    double ms_cage = 0, ms_mvc = 0;
+  };
+  auto cage_stage = [&source, &src, &opt, user_cage](const Progress& cage_progress, const Progress& mvc_progress,
+                                                      bool threaded) {
+    CageStage r;
+    auto t = clock::now();
+    if (user_cage) {
+      r.C = user_cage->V;
+      r.CF = user_cage->F;
+      r.status = check_user_cage(source.V, r.C, &r.CF, opt.cage.min_clearance * 1e-3);
+      if (!r.status.ok()) return r;
+    } else {
+      EnclosingCage cage = enclosing_cage(source.V, source.F, opt.cage, cage_progress);
+      if (!cage.status.ok()) {
+        r.status = cage.status;
+        return r;
+      }
+      r.C = std::move(cage.V);
+      r.CF = std::move(cage.F);
+    }
+    r.ms_cage = elapsed_ms(t);
+    // Mean-value coordinates are similarity invariant: computed in normalized coordinates.
+    t = clock::now();
+    r.Cn = (r.C.rowwise() - src.centroid) / src.scale;
+    MeanValueCoordinates mvc;
+#if !defined(__EMSCRIPTEN__)
+    if (threaded && src.V.rows() >= 2048) {
+      // Rows of Ψ are independent: the second half on another thread (by now the eigenbases
+      // are usually done and their core is free).
+      const Eigen::Index h = src.V.rows() / 2;
+      const Eigen::MatrixXd lower_points = src.V.bottomRows(src.V.rows() - h);
+      auto lower = std::async(std::launch::async, [&] {
+        return mean_value_coordinates(lower_points, r.Cn, r.CF, mvc_progress);
+      });
+      mvc = mean_value_coordinates(src.V.topRows(h), r.Cn, r.CF, mvc_progress);
+      MeanValueCoordinates rest = lower.get();
+      if (mvc.status.ok() && !rest.status.ok()) mvc.status = rest.status;
+      if (mvc.status.ok()) {
+        Eigen::MatrixXd Psi(src.V.rows(), r.Cn.rows());
+        Psi.topRows(h) = mvc.Psi;
+        Psi.bottomRows(src.V.rows() - h) = rest.Psi;
+        mvc.Psi = std::move(Psi);
+      }
+    } else
+#endif
+    {
+      (void)threaded;
+      mvc = mean_value_coordinates(src.V, r.Cn, r.CF, mvc_progress);
+    }
+    if (!mvc.status.ok()) {
+      r.status = mvc.status;
+      return r;
+    }
+    r.Psi = std::move(mvc.Psi);
+    r.ms_mvc = elapsed_ms(t);
+    return r;
+  };
+  std::atomic<bool> stop_cage{false};
+  std::future<CageStage> cage_future;
+  struct CageReport {
+    std::mutex mutex;
+    bool forwarding = false;  // this thread waits: updates go straight to the caller's sink
+    bool recorded = false;
+    std::string stage;
+    double fraction = 0;
+  } report;
+  const Progress cage_range = progress.sub(0.4, 0.85);
+#if !defined(__EMSCRIPTEN__)
+  if (opt.method == TransferMethod::Yin) {
+    const Progress watch([&](const std::string& stage, double f) {
+      std::lock_guard<std::mutex> lock(report.mutex);
+      f = std::max(f, report.fraction);
+      report.stage = stage;
+      report.fraction = f;
+      report.recorded = true;
+      if (report.forwarding && !cage_range.update(stage, f)) stop_cage.store(true);
+      return !stop_cage.load();
+    });
+    cage_future = std::async(std::launch::async, cage_stage, watch.sub(0.0, 0.45), watch.sub(0.45, 1.0), true);
+  }
+#endif
+  // Whatever returns early below stops the cage thread first (the future's destructor waits).
+  struct StopOnExit {
+    std::atomic<bool>& flag;
+    ~StopOnExit() { flag.store(true); }
+  } stop_on_exit{stop_cage};
+
   // 2. Eigenbases.
   auto t0 = clock::now();
   SpectralBasisOptions so;
@@ -177,47 +276,34 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
   if (opt.method != TransferMethod::Yin) {
     Vn = src.V + PhiK_src * (alpha_ref - alpha_src);  // Eq. 4
   } else {
-    // 4. Cage.
-    t0 = clock::now();
-    Eigen::MatrixXd C;
-    Eigen::MatrixXi CF;
-    if (user_cage) {
-      C = user_cage->V;
-      CF = user_cage->F;
-      Status s = check_user_cage(source.V, C, &CF, opt.cage.min_clearance * 1e-3);
-      if (!s.ok()) {
-        out.status = s;
-        return out;
-      }
-    } else {
-      EnclosingCage cage = enclosing_cage(source.V, source.F, opt.cage, progress.sub(0.4, 0.6));
-      if (!cage.status.ok()) {
-        out.status = cage.status;
-        return out;
-      }
-      C = std::move(cage.V);
-      CF = std::move(cage.F);
+    if (cage_future.valid()) {
+      std::lock_guard<std::mutex> lock(report.mutex);
+      report.forwarding = true;
+      if (report.recorded && !cage_range.update(report.stage, report.fraction)) stop_cage.store(true);
     }
-    out.cage_rest = C;
-    out.cage_faces = CF;
-    out.ms.cage = elapsed_ms(t0);
-
-    // 5. Mean-value coordinates (similarity invariant: computed in normalized coordinates).
-    t0 = clock::now();
-    const Eigen::MatrixXd Cn = (C.rowwise() - src.centroid) / src.scale;
-    const MeanValueCoordinates mvc = mean_value_coordinates(src.V, Cn, CF, progress.sub(0.6, 0.85));
-    if (!mvc.status.ok()) {
-      out.status = mvc.status;
+    CageStage cs = cage_future.valid() ? cage_future.get()
+                                       : cage_stage(progress.sub(0.4, 0.6), progress.sub(0.6, 0.85), false);
+    if (!cs.status.ok()) {
+      out.status = cs.status;
       return out;
     }
-    out.ms.mvc = elapsed_ms(t0);
+    if (!cage_range.update("mean-value coordinates", 1.0)) {
+      out.status = cancelled_status("mean-value coordinates");
+      return out;
+    }
+    out.cage_rest = cs.C;
+    out.cage_faces = cs.CF;
+    out.ms.cage = cs.ms_cage;
+    out.ms.mvc = cs.ms_mvc;
+    const Eigen::MatrixXd& Cn = cs.Cn;
+    const Eigen::MatrixXi& CF = cs.CF;
 
     // 6. Optimisation (Eq. 12, App. B).
     t0 = clock::now();
     CagePoseProblem prob;
     prob.C = Cn;
     prob.CF = CF;
-    prob.P = PhiK_src.transpose() * src.mass.asDiagonal() * mvc.Psi;  // Eq. 8: Φ̂_Kᵀ A Ψ
+    prob.P = PhiK_src.transpose() * src.mass.asDiagonal() * cs.Psi;  // Eq. 8: Φ̂_Kᵀ A Ψ
     prob.T = alpha_ref;
     const CagePoseResult sol = solve_cage_pose(prob, opt.solver, progress.sub(0.85, 1.0));
     if (!sol.status.ok()) {
@@ -230,7 +316,7 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
     out.energy_lf = sol.energy_lf;
     out.energy_lc = sol.energy_lc;
     out.energy_sf = sol.energy_sf;
-    Vn = mvc.Psi * sol.C;
+    Vn = cs.Psi * sol.C;
     const Eigen::RowVector3d place = opt.placement == TransferPlacement::Reference ? ref.centroid : src.centroid;
     out.cage_deformed = (src.scale * sol.C).rowwise() + place;
     out.ms.optimisation = elapsed_ms(t0);

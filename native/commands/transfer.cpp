@@ -25,7 +25,7 @@ const char* kTransferHelp =
     "  --lambda2 X          scale penalty weight (default 0.05)\n"
     "  --num-low-frequencies K   transferred coefficients 0..K (default 5)\n"
     "  --num-eigenpairs N   eigenpairs per mesh (default 20)\n"
-    "  --cage-vertices N    automatic cage size (default 300)\n"
+    "  --cage-vertices N    automatic cage size (default 450)\n"
     "  --cage-resolution N  offset grid cells along the longest side for the automatic cage (default 80)\n"
     "  --max-iterations N   re-linearizations of the cage solve (default 50)\n"
     "  --placement P        reference (default) | source: where the result is centred\n"
