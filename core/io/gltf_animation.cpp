@@ -77,6 +77,7 @@ CharacterResult animated_character(const Asset& asset, const CharacterOptions& o
   c.node_names.resize(nn);
   c.node_parent.assign(nn, -1);
   c.node_has_matrix.assign(nn, false);
+  c.node_mesh.assign(nn, -1);
   c.node_matrix.assign(nn, Eigen::Matrix4d::Identity());
   c.node_t.assign(nn, Eigen::Vector3d::Zero());
   c.node_s.assign(nn, Eigen::Vector3d::Ones());
@@ -88,6 +89,7 @@ CharacterResult animated_character(const Asset& asset, const CharacterOptions& o
     if (seen.count(name) || n.name.empty()) name += "#" + std::to_string(i);
     seen[name] = i;
     c.node_names[i] = name;
+    c.node_mesh[i] = n.mesh >= 0 && n.mesh < static_cast<int>(m.meshes.size()) ? n.mesh : -1;
     for (int ch : n.children)
       if (ch >= 0 && ch < nn) c.node_parent[ch] = i;
     if (n.matrix.size() == 16) {

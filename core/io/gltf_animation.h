@@ -66,6 +66,7 @@ struct AnimatedCharacter {
   std::vector<std::string> node_names;   // unique: empty or repeated names get "#<index>" appended
   std::vector<int> node_parent;          // -1 for scene roots
   std::vector<bool> node_has_matrix;     // node given by a matrix (cannot be animated)
+  std::vector<int> node_mesh;            // mesh index of each node, -1 when it has none
   std::vector<Eigen::Matrix4d, Eigen::aligned_allocator<Eigen::Matrix4d>> node_matrix;  // when has_matrix
   std::vector<Eigen::Vector3d> node_t, node_s;   // rest T and S
   std::vector<Eigen::Quaterniond, Eigen::aligned_allocator<Eigen::Quaterniond>> node_r;  // rest R
@@ -124,9 +125,27 @@ Matrix4dList node_motions(const AnimatedCharacter& c, const Matrix4dList& world)
 // Frame times: from `start` to `end` (clip range when both are < 0) at `fps`, both ends included.
 std::vector<double> frame_times(const AnimationClip& clip, double fps, double start = -1, double end = -1);
 
+// Props: meshes of a glTF target that are not part of its surface (weapons, helmets, capes)
+// hanging under a joint node. The retargeted surface moves through morph targets, so a prop
+// would stay where it is; instead its nearest joint ancestor gets a rigid motion per frame: the
+// best rigid fit (Kabsch) from the rest surface to the frame of the vertices that joint
+// dominates in the skin (or, when it dominates none, its nearest ancestor that does). A joint
+// is left alone when a surface part hangs below it or when it is given by a matrix.
+struct NodeTrack {
+  int node = -1;                                   // the joint node that is animated
+  std::vector<int> props;                          // prop nodes that follow it
+  int anchor_joint = -1;                           // joint whose vertices define the motion
+  std::vector<int> anchor_vertices;                // rows of V_rest
+  std::vector<Eigen::Vector3d> translation;        // per frame, local T
+  std::vector<Eigen::Quaterniond, Eigen::aligned_allocator<Eigen::Quaterniond>> rotation;  // per frame, local R
+  std::vector<Eigen::Matrix4d, Eigen::aligned_allocator<Eigen::Matrix4d>> world;          // per frame, world matrix
+};
+std::vector<NodeTrack> prop_tracks(const AnimatedCharacter& c, const std::vector<Eigen::MatrixXd>& frames);
+
 struct MorphAnimationOptions {
   std::string animation_name = "retarget";  // name of the written animation
   bool normals = true;                      // also write NORMAL deltas (lit correctly while playing)
+  bool props_follow = true;                 // animate the joints that carry props (prop_tracks)
 };
 
 // The target with its animation: a GLB whose surface meshes carry one morph target per frame and
