@@ -180,8 +180,8 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
     r.ms_mvc = elapsed_ms(t);
     return r;
   };
+  // Declared before the future: its destructor waits for the thread, which uses these.
   std::atomic<bool> stop_cage{false};
-  std::future<CageStage> cage_future;
   struct CageReport {
     std::mutex mutex;
     bool forwarding = false;  // this thread waits: updates go straight to the caller's sink
@@ -190,6 +190,7 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
     double fraction = 0;
   } report;
   const Progress cage_range = progress.sub(0.4, 0.85);
+  std::future<CageStage> cage_future;
 #if !defined(__EMSCRIPTEN__)
   if (opt.method == TransferMethod::Yin) {
     const Progress watch([&](const std::string& stage, double f) {
