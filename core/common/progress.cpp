@@ -10,12 +10,12 @@ Progress::Progress(Callback callback) : state_(std::make_shared<State>()) {
 
 bool Progress::update(const std::string& stage, double fraction) const {
   if (!state_) return true;
-  if (state_->cancelled) return false;
+  if (state_->cancelled.load()) return false;
   if (state_->callback) {
     const double f = begin_ + (end_ - begin_) * std::clamp(fraction, 0.0, 1.0);
-    if (!state_->callback(stage, f)) state_->cancelled = true;
+    if (!state_->callback(stage, f)) state_->cancelled.store(true);
   }
-  return !state_->cancelled;
+  return !state_->cancelled.load();
 }
 
 Progress Progress::sub(double begin, double end) const {

@@ -9,6 +9,7 @@
 //   if (!progress.update("factor", 0.5)) return cancelled_status("factor");
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <string>
@@ -27,10 +28,11 @@ class Progress {
 
   // Reports `fraction` (0..1 within this sub-range) of `stage`. Returns false once cancel
   // was requested (by the callback now or earlier); the computation should then stop.
+  // Threads may share a sink when its callback is thread-safe (the cancel flag is atomic).
   bool update(const std::string& stage, double fraction) const;
 
   // True once any update returned false.
-  bool cancelled() const { return state_ && state_->cancelled; }
+  bool cancelled() const { return state_ && state_->cancelled.load(); }
 
   // A sink whose 0..1 maps to [begin, end] of this one (both in 0..1 of this sub-range).
   Progress sub(double begin, double end) const;
@@ -38,7 +40,7 @@ class Progress {
  private:
   struct State {
     Callback callback;
-    bool cancelled = false;
+    std::atomic<bool> cancelled{false};  // several threads may report (pose_transfer's cage thread)
   };
   std::shared_ptr<State> state_;
   double begin_ = 0.0;
