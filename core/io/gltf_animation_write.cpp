@@ -275,7 +275,6 @@ std::vector<NodeTrack> prop_tracks(const AnimatedCharacter& c, const std::vector
     const int p = c.node_parent[n];
     local_rest[n] = p >= 0 ? Eigen::Matrix4d(rest[p].inverse() * rest[n]) : rest[n];
   }
-  std::vector<int> order = c.traversal;  // parents before children
   for (NodeTrack& t : tracks) {
     const int m = static_cast<int>(t.anchor_vertices.size());
     Eigen::MatrixXd X(m, 3);
@@ -301,7 +300,7 @@ std::vector<NodeTrack> prop_tracks(const AnimatedCharacter& c, const std::vector
   for (size_t f = 0; f < frames.size(); ++f) {
     Matrix4dList world(nn, Eigen::Matrix4d::Identity());
     std::vector<bool> done(nn, false);
-    for (int n : order) {
+    for (int n : c.traversal) {  // parents before children
       const int p = c.node_parent[n];
       const Eigen::Matrix4d parent = p >= 0 && done[p] ? world[p] : Eigen::Matrix4d::Identity();
       if (tracked[n] >= 0) {

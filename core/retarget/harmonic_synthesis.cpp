@@ -50,20 +50,6 @@ Status HarmonicSynthesis::factor(double ridge) {
   return Status::success();
 }
 
-Status HarmonicSynthesis::solve(const std::vector<const Eigen::MatrixXd*>& B, Eigen::MatrixXd* W) const {
-  if (!factored_) return Status::error(StatusCode::InvalidArgument, "synthesis solve before factor");
-  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n_, 3);
-  for (int k = 0; k < num_terms() && k < static_cast<int>(B.size()); ++k) {
-    const SynthesisTerm& t = terms_[k];
-    if (t.zero_rhs || !B[k] || B[k]->size() == 0) continue;
-    assert(B[k]->rows() == t.A.rows() && B[k]->cols() == 3);
-    rhs.noalias() += t.weight * (t.A.transpose() * *B[k]);
-  }
-  *W = impl_->llt.solve(rhs);
-  if (!W->allFinite()) return Status::error(StatusCode::NumericalError, "synthesized coefficients are not finite");
-  return Status::success();
-}
-
 Eigen::MatrixXd HarmonicSynthesis::solution_operator(int k, const Eigen::MatrixXd& M) const {
   assert(factored_ && k >= 0 && k < num_terms());
   const SynthesisTerm& t = terms_[k];

@@ -2,12 +2,13 @@
 // Eq. 15–18) from a list of terms E_k = w_k ‖A_k Wt − B_k‖²_F.
 //
 // Every term's matrix A_k is fixed per character pair, so the normal matrix
-// N = Σ w_k A_kᵀA_k (+ a tiny ridge) is factored once (dense Cholesky, N_a by N_a) and each
-// frame only forms Σ w_k A_kᵀB_k and back-substitutes: Wt = N⁻¹ Σ w_k A_kᵀ B_k (Eq. 18).
-// The three columns of Wt (x, y, z) share N and are solved together.
+// N = Σ w_k A_kᵀA_k (+ a tiny ridge) is factored once (dense Cholesky, N_a by N_a). The solution
+// Wt = N⁻¹ Σ w_k A_kᵀ B_k (Eq. 18) is linear in each right-hand side, so the caller forms the
+// operators N⁻¹ w_k A_kᵀ M_k once (solution_operator) and each frame is a few small products.
+// The three columns of Wt (x, y, z) share N.
 //
 // Terms are open-ended so that the context-graph terms (spatial, volume; paper Sec. 6) plug in
-// beside affine, position, bone and smoothness: add the term, refactor, pass its B per frame.
+// beside affine, position, bone and smoothness: add the term, refactor, take its operator.
 #pragma once
 
 #include <memory>
@@ -47,10 +48,6 @@ class HarmonicSynthesis {
   // otherwise make N singular. FactorizationFailed when N is still not positive definite.
   Status factor(double ridge = 1e-9);
   bool factored() const { return factored_; }
-
-  // Wt (N_a by 3) from the right-hand sides B_k (rows_k by 3), one per term in term order;
-  // nullptr or empty for zero_rhs terms. NumericalError when the result is not finite.
-  Status solve(const std::vector<const Eigen::MatrixXd*>& B, Eigen::MatrixXd* W) const;
 
   // The solution is linear in each right-hand side: Wt = Σ_k N⁻¹ w_k A_kᵀ B_k. When B_k = M_k y
   // for a fixed M_k (rows_k by c) and a per-frame y, the operator N⁻¹ w_k A_kᵀ M_k (N_a by c)
