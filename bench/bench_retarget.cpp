@@ -6,7 +6,7 @@
 
 #include "bench.h"
 #include "io/asset.h"
-#include "io/retarget_session.h"
+#include "app/retarget_job.h"
 
 namespace {
 
@@ -28,10 +28,10 @@ void bench_retarget(mm::bench::Context& ctx) {
       ss << in.rdbuf();
       joints = ss.str();
     }
-    mm::io::RetargetJobOptions opt;
+    mm::app::RetargetJobOptions opt;
     opt.clip = c.clip;
     opt.last_frame = ctx.quick ? 4 : 16;
-    mm::io::RetargetSession session;
+    mm::app::RetargetJob session;
     mm::Status status;
     const double pre = ctx.time_ms([&] { status = session.prepare(src.asset, tgt.asset, joints, "", opt); }, ctx.quick ? 1 : 3);
     if (!status.ok()) continue;

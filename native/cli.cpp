@@ -39,6 +39,14 @@ Status Args::parse(const std::vector<std::string>& argv, const std::vector<std::
   return Status::success();
 }
 
+Status check_unused(const Args& args) {
+  for (const auto& u : args.unused()) {
+    const std::string shown = u.size() > 60 ? u.substr(0, 60) + "..." : u;
+    return Status::error(StatusCode::InvalidArgument, "unknown option --" + shown);
+  }
+  return Status::success();
+}
+
 std::string Args::get(const std::string& name, const std::string& fallback) const {
   auto it = values_.find(name);
   if (it == values_.end()) return fallback;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "app/option_schema.h"
 #include "common/progress.h"
 #include "common/status.h"
 
@@ -32,6 +33,21 @@ class Args {
   std::map<std::string, std::string> values_;
   mutable std::map<std::string, bool> read_;
 };
+
+// Reads every option of `schema` given on the command line (--name-with-dashes VALUE) into *o.
+template <class O>
+Status read_options(const Args& args, const app::OptionSchema<O>& schema, O* o) {
+  for (const auto& e : schema.entries()) {
+    const std::string flag = e.info.cli_flag().substr(2);
+    if (!args.has(flag)) continue;
+    if (Status s = e.set(*o, app::OptionValue::of_text(args.get(flag))); !s.ok())
+      return Status::error(s.code, "--" + flag + ": " + s.message);
+  }
+  return Status::success();
+}
+
+// The "unknown option --x" error for flags nobody read (typos), or success.
+Status check_unused(const Args& args);
 
 // A progress sink drawing a bar on stderr — only when stderr is a terminal.
 Progress terminal_progress();

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "edit/edit_spec.h"
+#include "app/edit_spec.h"
 #include "edit/implicit_gradients.h"
 #include "edit/laplacian_editor.h"
 #include "edit/selection.h"

@@ -14,7 +14,7 @@
 
 namespace {
 
-using mm::io::AnimatedCharacter;
+using mm::AnimatedCharacter;
 
 struct Loaded {
   mm::io::LoadResult asset;
@@ -132,7 +132,7 @@ TEST(GltfAnimation, CesiumManMatchesFirstPrinciples) {
   ASSERT_EQ(c.parts.size(), 1u);
   const tinygltf::Model& m = *mm::io::gltf_model(l.asset.asset);
   for (double t : {0.05, 0.61, 1.234, 1.99}) {
-    const Eigen::MatrixXd V = mm::io::pose_at(c, 0, t);
+    const Eigen::MatrixXd V = mm::pose_at(c, 0, t);
     for (int v : {0, 777, 1500, 2345, 3272}) {
       const Eigen::Vector3d ref = first_principles(m, 0, t, v);
       EXPECT_LT((V.row(v).transpose() - ref).norm(), 1e-5) << "t " << t << " vertex " << v;
@@ -148,7 +148,7 @@ TEST(GltfAnimation, FoxMatchesFirstPrinciples) {
   const tinygltf::Model& m = *mm::io::gltf_model(l.asset.asset);
   for (int clip : {0, 1, 2})
     for (double t : {0.1, 0.5}) {
-      const Eigen::MatrixXd V = mm::io::pose_at(c, clip, t);
+      const Eigen::MatrixXd V = mm::pose_at(c, clip, t);
       for (int v : {0, 500, 1000, 1727}) {
         const Eigen::Vector3d ref = first_principles(m, clip, t, v);
         // Fox is ~100 units: 1e-5 relative.
@@ -183,11 +183,11 @@ TEST(GltfAnimation, MultiPartCharactersNeedNoWelding) {
     int nv = 0;
     for (const auto& p : c.parts) nv += p.num_vertices;
     EXPECT_EQ(nv, c.V_rest.rows());  // raw layout, nothing merged
-    const Eigen::MatrixXd V = mm::io::pose_at(c, 1, 0.3);
+    const Eigen::MatrixXd V = mm::pose_at(c, 1, 0.3);
     EXPECT_TRUE(V.allFinite());
     // LBS of the rest surface by node motions reproduces the evaluation (the baseline's premise).
-    const auto world = mm::io::node_world_matrices(c, 1, 0.3);
-    const Eigen::MatrixXd L = mm::linear_blend_skinning(c.V_rest, mm::io::character_skin_weights(c), mm::io::node_motions(c, world));
+    const auto world = mm::node_world_matrices(c, 1, 0.3);
+    const Eigen::MatrixXd L = mm::linear_blend_skinning(c.V_rest, mm::character_skin_weights(c), mm::node_motions(c, world));
     EXPECT_LT((L - V).cwiseAbs().maxCoeff(), 1e-6 * mm::bounding_box_diagonal(V));
   }
 }
@@ -202,25 +202,25 @@ TEST(GltfAnimation, StepAndCubicSplineSamplers) {
   c.node_s = {Eigen::Vector3d::Ones()};
   c.node_r.assign(1, Eigen::Quaterniond::Identity());
   c.traversal = {0};
-  mm::io::AnimationClip clip;
-  mm::io::AnimationChannel step;
+  mm::AnimationClip clip;
+  mm::AnimationChannel step;
   step.node = 0;
-  step.path = mm::io::AnimationChannel::Path::Translation;
-  step.interpolation = mm::io::AnimationChannel::Interpolation::Step;
+  step.path = mm::AnimationChannel::Path::Translation;
+  step.interpolation = mm::AnimationChannel::Interpolation::Step;
   step.times = Eigen::Vector2d(0, 1);
   step.values.resize(2, 3);
   step.values << 1, 2, 3, 4, 5, 6;
-  mm::io::AnimationChannel cubic;  // scale: in-tangent, value, out-tangent per key
+  mm::AnimationChannel cubic;  // scale: in-tangent, value, out-tangent per key
   cubic.node = 0;
-  cubic.path = mm::io::AnimationChannel::Path::Scale;
-  cubic.interpolation = mm::io::AnimationChannel::Interpolation::CubicSpline;
+  cubic.path = mm::AnimationChannel::Path::Scale;
+  cubic.interpolation = mm::AnimationChannel::Interpolation::CubicSpline;
   cubic.times = Eigen::Vector2d(0, 2);
   cubic.values.resize(6, 3);
   cubic.values << 0, 0, 0, 1, 1, 1, 1, 0, 0,   // key 0: value 1, out-tangent (1,0,0)
                   0, 0, 0, 3, 3, 3, 0, 0, 0;   // key 1: value 3, in-tangent 0
   clip.channels = {step, cubic};
   c.clips = {clip};
-  const auto W = mm::io::node_world_matrices(c, 0, 0.5);
+  const auto W = mm::node_world_matrices(c, 0, 0.5);
   EXPECT_LT((W[0].topRightCorner<3, 1>() - Eigen::Vector3d(1, 2, 3)).norm(), 1e-12);  // STEP holds key 0
   // Hermite at u = 0.25, dt = 2: (2u³−3u²+1)·1 + (u³−2u²+u)·2·b0 + (−2u³+3u²)·3.
   const double u = 0.25, h00 = 2 * u * u * u - 3 * u * u + 1, h10 = u * u * u - 2 * u * u + u, h01 = -2 * u * u * u + 3 * u * u;
@@ -238,7 +238,7 @@ TEST(GltfAnimation, MorphAnimationExportRoundTrip) {
   std::vector<double> times;
   for (int k = 0; k < 4; ++k) {
     times.push_back(0.1 * k);
-    frames.push_back(mm::io::pose_at(c, 1, 0.1 * k));
+    frames.push_back(mm::pose_at(c, 1, 0.1 * k));
   }
   std::vector<uint8_t> glb;
   ASSERT_TRUE(mm::io::write_morph_animation(fox.asset.asset, &c, frames, times, &glb).ok());
@@ -256,7 +256,7 @@ TEST(GltfAnimation, MorphAnimationExportRoundTrip) {
   const Eigen::MatrixXd d2 = accessor(m, prim.targets[2].at("POSITION"));
   mm::io::CharacterResult cb = mm::io::animated_character(back.asset);
   ASSERT_TRUE(cb.status.ok());
-  const Eigen::Matrix4d W = mm::io::node_world_matrices(cb.character, -1, 0)[c.parts[0].node];
+  const Eigen::Matrix4d W = mm::node_world_matrices(cb.character, -1, 0)[c.parts[0].node];
   for (int v : {0, 100, 1000}) {
     const Eigen::Vector3d p = W.topLeftCorner<3, 3>() * (base.row(v) + d2.row(v)).transpose() + W.topRightCorner<3, 1>();
     EXPECT_LT((p - frames[2].row(v).transpose()).norm(), 1e-3) << v;  // float storage of ~100-unit coordinates

@@ -16,12 +16,13 @@
 
 #include "io/asset.h"
 #include "io/gltf_animation.h"
-#include "io/retarget_session.h"
+#include "io/joints_json.h"
+#include "app/retarget_job.h"
 #include "mesh/mesh.h"
 #include "metrics/retarget_metrics.h"
 #include "retarget/harmonic_map.h"
 #include "retarget/harmonic_retarget.h"
-#include "retarget/joint_set.h"
+#include "character/joint_set.h"
 #include "retarget/lbs_baseline.h"
 #include "retarget/mfs_kernel.h"
 #include "test_support.h"
@@ -137,9 +138,9 @@ TEST(RetargetHarmonicMap, FitsRigidAndBentTube) {
 
 // ---------------------------------------------------------------- joints and their errors
 TEST(RetargetJoints, ParseAndMatchErrors) {
-  EXPECT_EQ(mm::parse_joints_json("[1,2]").status.code, mm::StatusCode::ParseError);
-  EXPECT_EQ(mm::parse_joints_json("{\"a\": [1, 2]}").status.code, mm::StatusCode::ParseError);
-  const mm::JointSetResult j = mm::parse_joints_json("{\"mid\": [0, 0.5, 0], \"root\": [0, 0.1, 0], \"foo\": [0, 0.9, 0]}");
+  EXPECT_EQ(mm::io::parse_joints_json("[1,2]").status.code, mm::StatusCode::ParseError);
+  EXPECT_EQ(mm::io::parse_joints_json("{\"a\": [1, 2]}").status.code, mm::StatusCode::ParseError);
+  const mm::io::JointSetResult j = mm::io::parse_joints_json("{\"mid\": [0, 0.5, 0], \"root\": [0, 0.1, 0], \"foo\": [0, 0.9, 0]}");
   ASSERT_TRUE(j.status.ok());
   EXPECT_TRUE(j.joints.from_user);
   const mm::JointSet src = tube_joints(1.0);
@@ -215,13 +216,13 @@ namespace {
 
 struct Job {
   mm::io::LoadResult src, tgt;
-  mm::io::RetargetSession session;
+  mm::app::RetargetJob session;
   mm::Status status;
 };
 
 std::unique_ptr<Job> job(const std::string& src, const std::string& tgt, const std::string& clip, double fps,
                          int last_frame, const std::string& joints_file = "",
-                         mm::io::RetargetMethod method = mm::io::RetargetMethod::Harmonic,
+                         mm::app::RetargetMethod method = mm::app::RetargetMethod::Harmonic,
                          const std::function<void(mm::HarmonicRetargetOptions&)>& tweak = {}) {
   auto j = std::make_unique<Job>();
   j->src = mm::io::load_asset(mm::test::data_path(src));
@@ -237,7 +238,7 @@ std::unique_ptr<Job> job(const std::string& src, const std::string& tgt, const s
     ss << in.rdbuf();
     joints = ss.str();
   }
-  mm::io::RetargetJobOptions o;
+  mm::app::RetargetJobOptions o;
   o.clip = clip;
   o.fps = fps;
   o.last_frame = last_frame;
@@ -294,7 +295,7 @@ TEST(RetargetReal, SelfRetargetingKayKitKnight) {
   // 600 singularities, 2500 collocation points and λ_bone = 0.3 (bone lengths held less
   // stiffly: the harmonic map's interior at the joints does not follow the skeleton exactly).
   auto b = job("anim/KayKit/Knight.glb", "anim/KayKit/Knight.glb", "Walking_A", 10, -1, "",
-               mm::io::RetargetMethod::Harmonic, larger_budget);
+               mm::app::RetargetMethod::Harmonic, larger_budget);
   ASSERT_TRUE(b->status.ok()) << b->status.message;
   const mm::SequenceError eb = self_error(*b);
   RecordProperty("mean_error_over_height_larger_budget", std::to_string(eb.mean));
@@ -316,15 +317,15 @@ TEST(RetargetReal, SelfRetargetingKayKitBarbarian) {
 TEST(RetargetReal, KnightToBarbarianHarmonicVsLbs) {
   auto h = job("anim/KayKit/Knight.glb", "anim/KayKit/Barbarian.glb", "Walking_A", 10, -1);
   auto l = job("anim/KayKit/Knight.glb", "anim/KayKit/Barbarian.glb", "Walking_A", 10, -1, "",
-               mm::io::RetargetMethod::Lbs);
+               mm::app::RetargetMethod::Lbs);
   ASSERT_TRUE(h->status.ok()) << h->status.message;
   ASSERT_TRUE(l->status.ok()) << l->status.message;
   // Ground truth: Barbarian's own skinned clip of the same name at the same times.
-  const mm::io::AnimatedCharacter& barb = *h->session.target_character();
+  const mm::AnimatedCharacter& barb = *h->session.target_character();
   int clip = -1;
-  ASSERT_TRUE(mm::io::find_clip(barb, "Walking_A", &clip).ok());
+  ASSERT_TRUE(mm::find_clip(barb, "Walking_A", &clip).ok());
   std::vector<Eigen::MatrixXd> gt, vh, vl;
-  for (int k = 0; k < h->session.num_frames(); ++k) gt.push_back(mm::io::pose_at(barb, clip, h->session.times()[k]));
+  for (int k = 0; k < h->session.num_frames(); ++k) gt.push_back(mm::pose_at(barb, clip, h->session.times()[k]));
   ASSERT_TRUE(h->session.frames(0, h->session.num_frames(), &vh).ok());
   ASSERT_TRUE(l->session.frames(0, l->session.num_frames(), &vl).ok());
   const double H = height(barb.V_rest);
@@ -385,8 +386,8 @@ TEST(RetargetReal, PropsFollowTheirJointsInTheExportedGlb) {
     std::ofstream out(mm::test::scratch_path("retarget_props.glb"), std::ios::binary);  // glTF-Validator (JS tests)
     out.write(reinterpret_cast<const char*>(glb.data()), static_cast<std::streamsize>(glb.size()));
   }
-  const mm::io::AnimatedCharacter& barb = *j->session.target_character();
-  const std::vector<mm::io::NodeTrack> tracks = mm::io::prop_tracks(barb, frames);
+  const mm::AnimatedCharacter& barb = *j->session.target_character();
+  const std::vector<mm::NodeTrack> tracks = mm::prop_tracks(barb, frames);
   std::set<std::string> followed;
   for (const auto& t : tracks)
     for (int p : t.props) followed.insert(barb.node_names[p]);
@@ -402,13 +403,13 @@ TEST(RetargetReal, PropsFollowTheirJointsInTheExportedGlb) {
   ASSERT_TRUE(bc.status.ok()) << bc.status.message;
   ASSERT_EQ(bc.character.clips.size(), 1u);
   const double H = height(barb.V_rest);
-  const mm::io::Matrix4dList rest = mm::io::node_world_matrices(bc.character, -1, 0);
+  const mm::Matrix4dList rest = mm::node_world_matrices(bc.character, -1, 0);
   double export_error = 0, largest_turn = 0;
   for (const auto& t : tracks) {
     double sum = 0;
     int count = 0;
     for (size_t f = 0; f < frames.size(); ++f) {
-      const mm::io::Matrix4dList world = mm::io::node_world_matrices(bc.character, 0, times[f]);
+      const mm::Matrix4dList world = mm::node_world_matrices(bc.character, 0, times[f]);
       const Eigen::Matrix4d expected = t.world[f] * rest[t.node].inverse();
       for (int p : t.props) {
         const Eigen::Matrix4d M = world[p] * rest[p].inverse();

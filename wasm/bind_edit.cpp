@@ -5,7 +5,7 @@
 // JS API — one stateful handle, the editing session:
 //   const s = new module.EditSession();
 //   s.create(positions: Float64Array|Float32Array (#V·3), indices: Uint32Array (#F·3),
-//            spec: object | JSON string (core/edit/edit_spec.h), progress?: (stage, f) => bool)
+//            spec: object | JSON string (app/edit_spec.h), progress?: (stage, f) => bool)
 //     → {ok, handles: [vertex count per handle], vertices, stats: {free_vertices, known_vertices,
 //        degenerate_vertices, displaced_vertices, widened_stencils, coherence_pairs,
 //        system_nonzeros, mean_edge_length, stencil_ms, assembly_ms, factor_ms, basis_ms,
@@ -20,7 +20,7 @@
 //                                                            → {ok, positions: Float32Array}
 //   s.dispose()  frees the editor's memory (the JS wrapper then calls s.delete()).
 // Failures are {ok:false, code, message} (convert.h status_object); a stray C++ exception is
-// returned as code "Internal" so the worker stays usable.
+// returned as code "Internal" by the guard (guard.h) so the worker stays usable.
 #include <string>
 #include <vector>
 
@@ -28,7 +28,8 @@
 #include <emscripten/val.h>
 
 #include "convert.h"
-#include "edit/edit_spec.h"
+#include "guard.h"
+#include "app/edit_spec.h"
 #include "edit/laplacian_editor.h"
 
 namespace mm::wasm {
@@ -36,14 +37,6 @@ namespace mm::wasm {
 using emscripten::val;
 
 namespace {
-
-val edit_internal_error(const std::string& what) {
-  val o = val::object();
-  o.set("ok", false);
-  o.set("code", std::string("Internal"));
-  o.set("message", "internal error: " + what);
-  return o;
-}
 
 std::string edit_json_text(const val& v) {
   if (v.isString()) return v.as<std::string>();
@@ -71,79 +64,64 @@ val edit_positions(const EditResult& r) {
 
 class EditSession {
  public:
+  static constexpr const char* kName = "EditSession";
   val create(const val& positions, const val& indices, const val& spec, const val& progress) {
-    try {
-      editor_ = LaplacianEditor();
-      V_ = to_matrix(positions);
-      F_ = to_index_matrix(indices);
-      EditSpecResult sr = parse_edit_spec(edit_json_text(spec), V_, F_);
-      if (!sr.status.ok()) return status_object(sr.status);
-      spec_ = sr.spec;
-      Status s = editor_.precompute(V_, F_, spec_.region, spec_.options, js_progress(progress));
-      if (!s.ok()) return status_object(s);
-      val o = status_object(s);
-      val handles = val::array(), transforms = val::array();
-      for (size_t h = 0; h < spec_.region.handles.size(); ++h) {
-        handles.set(h, static_cast<int>(spec_.region.handles[h].size()));
-        transforms.set(h, edit_matrix_array(spec_.transforms[h]));
-      }
-      o.set("handles", handles);
-      o.set("transforms", transforms);
-      o.set("vertices", static_cast<int>(V_.rows()));
-      o.set("features", std::string(spec_.features == FeatureSize::Scale ? "scale" : "keep"));
-      const EditStats& st = editor_.stats();
-      val stats = val::object();
-      stats.set("free_vertices", st.free_vertices);
-      stats.set("known_vertices", st.known_vertices);
-      stats.set("degenerate_vertices", st.degenerate_vertices);
-      stats.set("displaced_vertices", st.displaced_vertices);
-      stats.set("widened_stencils", st.widened_stencils);
-      stats.set("coherence_pairs", st.coherence_pairs);
-      stats.set("system_nonzeros", static_cast<double>(st.system_nonzeros));
-      stats.set("mean_edge_length", st.mean_edge_length);
-      stats.set("stencil_ms", st.stencil_ms);
-      stats.set("assembly_ms", st.assembly_ms);
-      stats.set("factor_ms", st.factor_ms);
-      stats.set("basis_ms", st.basis_ms);
-      stats.set("poisson_ms", st.poisson_ms);
-      o.set("stats", stats);
-      return o;
-    } catch (const std::exception& e) {
-      return edit_internal_error(e.what());
+    editor_ = LaplacianEditor();
+    V_ = to_matrix(positions);
+    F_ = to_index_matrix(indices);
+    EditSpecResult sr = parse_edit_spec(edit_json_text(spec), V_, F_);
+    if (!sr.status.ok()) return status_object(sr.status);
+    spec_ = sr.spec;
+    Status s = editor_.precompute(V_, F_, spec_.region, spec_.options, js_progress(progress));
+    if (!s.ok()) return status_object(s);
+    val o = status_object(s);
+    val handles = val::array(), transforms = val::array();
+    for (size_t h = 0; h < spec_.region.handles.size(); ++h) {
+      handles.set(h, static_cast<int>(spec_.region.handles[h].size()));
+      transforms.set(h, edit_matrix_array(spec_.transforms[h]));
     }
+    o.set("handles", handles);
+    o.set("transforms", transforms);
+    o.set("vertices", static_cast<int>(V_.rows()));
+    o.set("features", std::string(spec_.features == FeatureSize::Scale ? "scale" : "keep"));
+    const EditStats& st = editor_.stats();
+    val stats = val::object();
+    stats.set("free_vertices", st.free_vertices);
+    stats.set("known_vertices", st.known_vertices);
+    stats.set("degenerate_vertices", st.degenerate_vertices);
+    stats.set("displaced_vertices", st.displaced_vertices);
+    stats.set("widened_stencils", st.widened_stencils);
+    stats.set("coherence_pairs", st.coherence_pairs);
+    stats.set("system_nonzeros", static_cast<double>(st.system_nonzeros));
+    stats.set("mean_edge_length", st.mean_edge_length);
+    stats.set("stencil_ms", st.stencil_ms);
+    stats.set("assembly_ms", st.assembly_ms);
+    stats.set("factor_ms", st.factor_ms);
+    stats.set("basis_ms", st.basis_ms);
+    stats.set("poisson_ms", st.poisson_ms);
+    o.set("stats", stats);
+    return o;
   }
 
   val drag(const val& transforms) {
-    try {
-      HandleTransformsResult t = parse_handle_transforms(edit_json_text(transforms), V_, spec_.region);
-      if (!t.status.ok()) return status_object(t.status);
-      return edit_positions(editor_.drag(t.transforms));
-    } catch (const std::exception& e) {
-      return edit_internal_error(e.what());
-    }
+    HandleTransformsResult t = parse_handle_transforms(edit_json_text(transforms), V_, spec_.region);
+    if (!t.status.ok()) return status_object(t.status);
+    return edit_positions(editor_.drag(t.transforms));
   }
 
   val dragPositions(const val& targets) {
-    try {
-      return edit_positions(editor_.drag_positions(to_matrix(targets)));
-    } catch (const std::exception& e) {
-      return edit_internal_error(e.what());
-    }
+    return edit_positions(editor_.drag_positions(to_matrix(targets)));
   }
 
   val finalize(const val& mode) {
-    try {
-      FeatureSize f = spec_.features;
-      if (mode.isString()) {
-        const std::string m = mode.as<std::string>();
-        if (m != "keep" && m != "scale")
-          return status_object(Status::error(StatusCode::InvalidArgument, "finalize mode must be \"keep\" or \"scale\""));
-        f = m == "scale" ? FeatureSize::Scale : FeatureSize::Keep;
-      }
-      return edit_positions(editor_.finalize(f));
-    } catch (const std::exception& e) {
-      return edit_internal_error(e.what());
+    FeatureSize f = spec_.features;
+    if (mode.isString()) {
+      const std::string m = mode.as<std::string>();
+      if (m != "keep" && m != "scale")
+        return status_object(Status::error(StatusCode::InvalidArgument, "finalize mode must be \"keep\" or \"scale\""));
+      f = m == "scale" ? FeatureSize::Scale : FeatureSize::Keep;
     }
+    return edit_positions(editor_.finalize(f));
   }
 
   void dispose() {
@@ -163,11 +141,11 @@ class EditSession {
 EMSCRIPTEN_BINDINGS(meshmorph_edit) {
   emscripten::class_<EditSession>("EditSession")
       .constructor<>()
-      .function("create", &EditSession::create)
-      .function("drag", &EditSession::drag)
-      .function("dragPositions", &EditSession::dragPositions)
-      .function("finalize", &EditSession::finalize)
-      .function("dispose", &EditSession::dispose);
+      .function("create", guarded_method<&EditSession::create>())
+      .function("drag", guarded_method<&EditSession::drag>())
+      .function("dragPositions", guarded_method<&EditSession::dragPositions>())
+      .function("finalize", guarded_method<&EditSession::finalize>())
+      .function("dispose", guarded_method<&EditSession::dispose>());
 }
 
 }  // namespace mm::wasm

@@ -44,6 +44,7 @@
 #include <emscripten/val.h>
 
 #include "convert.h"
+#include "guard.h"
 #include "io/asset.h"
 #include "io/info_report.h"
 #include "mesh/validate.h"
@@ -67,14 +68,6 @@ int g_next_asset_id = 1;
 
 val error_object(StatusCode code, const std::string& message) {
   return status_object(Status::error(code, message));
-}
-
-val internal_error(const std::string& what) {
-  val o = val::object();
-  o.set("ok", false);
-  o.set("code", std::string("Internal"));
-  o.set("message", "internal error: " + what);
-  return o;
 }
 
 std::optional<io::Format> parse_format(const std::string& name) {
@@ -169,182 +162,158 @@ std::string last_segment(const std::string& uri) {
 
 val load_asset_js(const val& bytes_js, const std::string& name, const val& files,
                   const val& options) {
-  try {
-    const std::optional<io::Format> format = io::format_from_path(name);
-    if (!format)
-      return error_object(StatusCode::Unsupported,
-                          "cannot tell the format of '" + name +
-                              "': expected a .glb, .gltf, .obj, .off or .ply file");
-    const std::vector<uint8_t> bytes = to_bytes(bytes_js);
+  const std::optional<io::Format> format = io::format_from_path(name);
+  if (!format)
+    return error_object(StatusCode::Unsupported,
+                        "cannot tell the format of '" + name +
+                            "': expected a .glb, .gltf, .obj, .off or .ply file");
+  const std::vector<uint8_t> bytes = to_bytes(bytes_js);
 
-    io::LoadOptions opt;
-    const val weld = options.isUndefined() || options.isNull() ? val::undefined() : options["weld"];
-    opt.weld.tolerance = get_number(weld, "tolerance", opt.weld.tolerance);
-    opt.weld.drop_degenerate_faces = get_bool(weld, "drop_degenerate_faces", opt.weld.drop_degenerate_faces);
-    opt.skip_unsupported_primitives =
-        get_bool(options, "skip_unsupported_primitives", opt.skip_unsupported_primitives);
+  io::LoadOptions opt;
+  const val weld = options.isUndefined() || options.isNull() ? val::undefined() : options["weld"];
+  opt.weld.tolerance = get_number(weld, "tolerance", opt.weld.tolerance);
+  opt.weld.drop_degenerate_faces = get_bool(weld, "drop_degenerate_faces", opt.weld.drop_degenerate_faces);
+  opt.skip_unsupported_primitives =
+      get_bool(options, "skip_unsupported_primitives", opt.skip_unsupported_primitives);
 
-    // The resolver only looks into the object the page built from the files the user chose,
-    // so it cannot reach anything else; io::load_asset_from_memory has already refused
-    // absolute paths and "..".
-    io::FileResolver resolver;
-    if (!files.isUndefined() && !files.isNull()) {
-      resolver = [&files](const std::string& uri, std::vector<uint8_t>* out) {
-        for (const std::string& key : {uri, last_segment(uri)}) {
-          const val f = files[key];
-          if (!f.isUndefined() && !f.isNull()) {
-            *out = to_bytes(f);
-            return true;
-          }
+  // The resolver only looks into the object the page built from the files the user chose,
+  // so it cannot reach anything else; io::load_asset_from_memory has already refused
+  // absolute paths and "..".
+  io::FileResolver resolver;
+  if (!files.isUndefined() && !files.isNull()) {
+    resolver = [&files](const std::string& uri, std::vector<uint8_t>* out) {
+      for (const std::string& key : {uri, last_segment(uri)}) {
+        const val f = files[key];
+        if (!f.isUndefined() && !f.isNull()) {
+          *out = to_bytes(f);
+          return true;
         }
-        return false;
-      };
-    }
-
-    io::LoadResult loaded = io::load_asset_from_memory(bytes, *format, name, resolver, opt);
-    if (!loaded.status.ok()) return status_object(loaded.status);
-
-    auto asset = std::make_unique<io::Asset>(std::move(loaded.asset));
-    // The `meshmorph info` report (text and JSON) so the page shows what the CLI prints.
-    const io::InfoReport info = io::info_report(*asset);
-    const Eigen::MatrixXd normals =
-        unweld(vertex_normals(asset->weld.V, asset->weld.F), asset->weld.to_welded);
-
-    val o = status_object(Status::success());
-    o.set("name", asset->source_name);
-    o.set("format", std::string(io::format_name(asset->format)));
-    o.set("warnings", string_array(asset->warnings));
-    o.set("primitives", primitives_array(*asset));
-    o.set("positions", to_float32_array(asset->V_raw));
-    o.set("indices", to_uint32_array(asset->F_raw));
-    o.set("normals", to_float32_array(normals));
-    o.set("toWelded", to_uint32_array(asset->weld.to_welded));
-    o.set("weldedPositions", to_float64_array(asset->weld.V));
-    o.set("weldedIndices", to_uint32_array(asset->weld.F));
-    o.set("report", report_object(info.welded));
-    o.set("text", info.text);
-    o.set("info", val::global("JSON").call<val>("parse", info.json));
-
-    const int id = g_next_asset_id++;
-    asset_registry()[id] = std::move(asset);
-    o.set("asset", id);
-    return o;
-  } catch (const std::exception& e) {
-    return internal_error(e.what());
-  } catch (...) {
-    return internal_error("unknown exception while loading");
+      }
+      return false;
+    };
   }
+
+  io::LoadResult loaded = io::load_asset_from_memory(bytes, *format, name, resolver, opt);
+  if (!loaded.status.ok()) return status_object(loaded.status);
+
+  auto asset = std::make_unique<io::Asset>(std::move(loaded.asset));
+  // The `meshmorph info` report (text and JSON) so the page shows what the CLI prints.
+  const io::InfoReport info = io::info_report(*asset);
+  const Eigen::MatrixXd normals =
+      unweld(vertex_normals(asset->weld.V, asset->weld.F), asset->weld.to_welded);
+
+  val o = status_object(Status::success());
+  o.set("name", asset->source_name);
+  o.set("format", std::string(io::format_name(asset->format)));
+  o.set("warnings", string_array(asset->warnings));
+  o.set("primitives", primitives_array(*asset));
+  o.set("positions", to_float32_array(asset->V_raw));
+  o.set("indices", to_uint32_array(asset->F_raw));
+  o.set("normals", to_float32_array(normals));
+  o.set("toWelded", to_uint32_array(asset->weld.to_welded));
+  o.set("weldedPositions", to_float64_array(asset->weld.V));
+  o.set("weldedIndices", to_uint32_array(asset->weld.F));
+  o.set("report", report_object(info.welded));
+  o.set("text", info.text);
+  o.set("info", val::global("JSON").call<val>("parse", info.json));
+
+  const int id = g_next_asset_id++;
+  asset_registry()[id] = std::move(asset);
+  o.set("asset", id);
+  return o;
 }
 
 bool dispose_asset_js(int id) { return asset_registry().erase(id) > 0; }
 
 val export_asset_js(int id, const val& positions, const std::string& format_name,
                     const val& options) {
-  try {
-    const auto it = asset_registry().find(id);
-    if (it == asset_registry().end())
-      return error_object(StatusCode::InvalidArgument, "no loaded asset with id " + std::to_string(id));
-    const io::Asset& asset = *it->second;
-    const std::optional<io::Format> format = parse_format(format_name.empty() ? "glb" : format_name);
-    if (!format) return error_object(StatusCode::InvalidArgument, "unknown export format '" + format_name + "'");
+  const auto it = asset_registry().find(id);
+  if (it == asset_registry().end())
+    return error_object(StatusCode::InvalidArgument, "no loaded asset with id " + std::to_string(id));
+  const io::Asset& asset = *it->second;
+  const std::optional<io::Format> format = parse_format(format_name.empty() ? "glb" : format_name);
+  if (!format) return error_object(StatusCode::InvalidArgument, "unknown export format '" + format_name + "'");
 
-    Eigen::MatrixXd V = asset.weld.V;
-    if (!positions.isUndefined() && !positions.isNull()) {
-      V = to_matrix(positions);
-      if (V.rows() != asset.weld.V.rows())
-        return error_object(StatusCode::InvalidArgument,
-                            "export got " + std::to_string(V.rows()) + " positions for a mesh of " +
-                                std::to_string(asset.weld.V.rows()) + " welded vertices");
-    }
-    io::SaveOptions opt;
-    opt.recompute_normals = get_bool(options, "recompute_normals", opt.recompute_normals);
-    std::vector<uint8_t> bytes;
-    const Status s = io::save_asset_to_memory(asset, V, *format, &bytes, opt);
-    if (!s.ok()) return status_object(s);
-    val o = status_object(s);
-    o.set("bytes", to_uint8_array(bytes));
-    return o;
-  } catch (const std::exception& e) {
-    return internal_error(e.what());
-  } catch (...) {
-    return internal_error("unknown exception while exporting");
+  Eigen::MatrixXd V = asset.weld.V;
+  if (!positions.isUndefined() && !positions.isNull()) {
+    V = to_matrix(positions);
+    if (V.rows() != asset.weld.V.rows())
+      return error_object(StatusCode::InvalidArgument,
+                          "export got " + std::to_string(V.rows()) + " positions for a mesh of " +
+                              std::to_string(asset.weld.V.rows()) + " welded vertices");
   }
+  io::SaveOptions opt;
+  opt.recompute_normals = get_bool(options, "recompute_normals", opt.recompute_normals);
+  std::vector<uint8_t> bytes;
+  const Status s = io::save_asset_to_memory(asset, V, *format, &bytes, opt);
+  if (!s.ok()) return status_object(s);
+  val o = status_object(s);
+  o.set("bytes", to_uint8_array(bytes));
+  return o;
 }
 
 val save_mesh_js(const std::string& format_name, const val& positions, const val& indices,
                  const val& colors) {
-  try {
-    const std::optional<io::Format> format = parse_format(format_name);
-    if (!format) return error_object(StatusCode::InvalidArgument, "unknown format '" + format_name + "'");
-    const Eigen::MatrixXd V = to_matrix(positions);
-    const Eigen::MatrixXi F = to_index_matrix(indices);
-    const Eigen::MatrixXd C = colors.isUndefined() || colors.isNull() ? Eigen::MatrixXd() : to_matrix(colors);
-    std::vector<uint8_t> bytes;
-    const Status s = io::save_mesh_to_memory(*format, V, F, &bytes, C);
-    if (!s.ok()) return status_object(s);
-    val o = status_object(s);
-    o.set("bytes", to_uint8_array(bytes));
-    return o;
-  } catch (const std::exception& e) {
-    return internal_error(e.what());
-  }
+  const std::optional<io::Format> format = parse_format(format_name);
+  if (!format) return error_object(StatusCode::InvalidArgument, "unknown format '" + format_name + "'");
+  const Eigen::MatrixXd V = to_matrix(positions);
+  const Eigen::MatrixXi F = to_index_matrix(indices);
+  const Eigen::MatrixXd C = colors.isUndefined() || colors.isNull() ? Eigen::MatrixXd() : to_matrix(colors);
+  std::vector<uint8_t> bytes;
+  const Status s = io::save_mesh_to_memory(*format, V, F, &bytes, C);
+  if (!s.ok()) return status_object(s);
+  val o = status_object(s);
+  o.set("bytes", to_uint8_array(bytes));
+  return o;
 }
 
 val validate_mesh_js(const val& positions, const val& indices, const val& options) {
-  try {
-    ValidateOptions opt;
-    opt.degenerate_area_tolerance =
-        get_number(options, "degenerate_area_tolerance", opt.degenerate_area_tolerance);
-    const MeshReport r = validate_mesh(to_matrix(positions), to_index_matrix(indices), opt);
-    val o = status_object(Status::success());
-    o.set("report", report_object(r));
-    o.set("text", r.to_text());
-    return o;
-  } catch (const std::exception& e) {
-    return internal_error(e.what());
-  }
+  ValidateOptions opt;
+  opt.degenerate_area_tolerance =
+      get_number(options, "degenerate_area_tolerance", opt.degenerate_area_tolerance);
+  const MeshReport r = validate_mesh(to_matrix(positions), to_index_matrix(indices), opt);
+  val o = status_object(Status::success());
+  o.set("report", report_object(r));
+  o.set("text", r.to_text());
+  return o;
 }
 
 val spectral_basis_js(const val& positions, const val& indices, const val& options,
                       const val& progress) {
-  try {
-    const Eigen::MatrixXd V = to_matrix(positions);
-    const Eigen::MatrixXi F = to_index_matrix(indices);
-    // The eigensolver needs a manifold surface (as `meshmorph eigs` checks): refuse bad input
-    // with the validator's message rather than letting the factorization fail obscurely.
-    const Status valid = check_mesh(V, F, manifold_defects());
-    if (!valid.ok()) return status_object(valid);
+  const Eigen::MatrixXd V = to_matrix(positions);
+  const Eigen::MatrixXi F = to_index_matrix(indices);
+  // The eigensolver needs a manifold surface (as `meshmorph eigs` checks): refuse bad input
+  // with the validator's message rather than letting the factorization fail obscurely.
+  const Status valid = check_mesh(V, F, manifold_defects());
+  if (!valid.ok()) return status_object(valid);
 
-    SpectralBasisOptions opt;
-    opt.k = get_int(options, "k", opt.k);
-    opt.ncv = get_int(options, "ncv", opt.ncv);
-    opt.relative_shift = get_number(options, "relative_shift", opt.relative_shift);
-    opt.tolerance = get_number(options, "tolerance", opt.tolerance);
-    opt.max_iterations = get_int(options, "max_iterations", opt.max_iterations);
+  SpectralBasisOptions opt;
+  opt.k = get_int(options, "k", opt.k);
+  opt.ncv = get_int(options, "ncv", opt.ncv);
+  opt.relative_shift = get_number(options, "relative_shift", opt.relative_shift);
+  opt.tolerance = get_number(options, "tolerance", opt.tolerance);
+  opt.max_iterations = get_int(options, "max_iterations", opt.max_iterations);
 
-    const SpectralBasis basis = spectral_basis(V, F, opt, js_progress(progress));
-    if (!basis.status.ok()) return status_object(basis.status);
-    val o = status_object(basis.status);
-    o.set("eigenvalues", to_float64_array(basis.eigenvalues));
-    // #V by k column-major = k by #V row-major: one contiguous block per basis function.
-    o.set("vectors", to_float32_array(basis.vectors.transpose()));
-    o.set("iterations", basis.iterations);
-    o.set("operations", basis.operations);
-    return o;
-  } catch (const std::exception& e) {
-    return internal_error(e.what());
-  }
+  const SpectralBasis basis = spectral_basis(V, F, opt, js_progress(progress));
+  if (!basis.status.ok()) return status_object(basis.status);
+  val o = status_object(basis.status);
+  o.set("eigenvalues", to_float64_array(basis.eigenvalues));
+  // #V by k column-major = k by #V row-major: one contiguous block per basis function.
+  o.set("vectors", to_float32_array(basis.vectors.transpose()));
+  o.set("iterations", basis.iterations);
+  o.set("operations", basis.operations);
+  return o;
 }
 
 }  // namespace
 
 EMSCRIPTEN_BINDINGS(meshmorph_mesh) {
-  emscripten::function("loadAsset", &load_asset_js);
-  emscripten::function("disposeAsset", &dispose_asset_js);
-  emscripten::function("exportAsset", &export_asset_js);
-  emscripten::function("saveMesh", &save_mesh_js);
-  emscripten::function("validateMesh", &validate_mesh_js);
-  emscripten::function("spectralBasis", &spectral_basis_js);
+  bind<&load_asset_js>("loadAsset");
+  bind<&dispose_asset_js>("disposeAsset");
+  bind<&export_asset_js>("exportAsset");
+  bind<&save_mesh_js>("saveMesh");
+  bind<&validate_mesh_js>("validateMesh");
+  bind<&spectral_basis_js>("spectralBasis");
 }
 
 }  // namespace mm::wasm

@@ -1,5 +1,5 @@
 // Bindings of the retarget module (paper 002) for the page's worker (web/src/ops/retarget.js).
-// Data conversion only: all work is io::RetargetSession (core/io/retarget_session.h).
+// Data conversion only: all work is app::RetargetJob (app/retarget_job.h).
 //
 // JS API:
 //   retargetPrepare(sourceBytes: Uint8Array, sourceName, targetBytes: Uint8Array, targetName,
@@ -7,9 +7,7 @@
 //                   options?, progress?) → {ok, session: number, frames, times: Float64Array,
 //                   clip, targetPositions: Float32Array (#V·3 rest surface), targetIndices:
 //                   Uint32Array, warnings: string[]}
-//     options: {clip, fps, first_frame, last_frame, method: "harmonic"|"lbs",
-//               num_singularities, num_collocation, offset, w_affine, w_position, w_smooth, w_bone,
-//               bone_iterations, surface_descriptors, anchor_joint}
+//     options: any option of the retarget job's schema (app/retarget_job.h; optionSchema("retarget"))
 //   retargetFrames(session, first, count, progress?) → {ok, positions: Float32Array
 //                   (count·#V·3, frame-major)}; progress returning false cancels (Cancelled)
 //   retargetExportGlb(session, positions: Float32Array|Float64Array (all frames, frame-major))
@@ -24,13 +22,14 @@
 
 #include "convert.h"
 #include "io/asset.h"
-#include "io/retarget_session.h"
+#include "app/retarget_job.h"
+#include "guard.h"
 
 namespace mm::wasm {
 namespace {
 
 struct RetargetSlot {
-  std::unique_ptr<io::RetargetSession> session;
+  std::unique_ptr<app::RetargetJob> session;
 };
 std::map<int, RetargetSlot>& retarget_sessions() {
   static std::map<int, RetargetSlot> s;
@@ -54,24 +53,9 @@ emscripten::val retarget_prepare(emscripten::val src, std::string src_name, emsc
   if (!s.status.ok()) return status_object(s.status);
   const io::LoadResult t = load_bytes(tgt, tgt_name);
   if (!t.status.ok()) return status_object(t.status);
-  io::RetargetJobOptions o;
-  o.clip = get_string(options, "clip", o.clip);
-  o.fps = get_number(options, "fps", o.fps);
-  o.first_frame = get_int(options, "first_frame", o.first_frame);
-  o.last_frame = get_int(options, "last_frame", o.last_frame);
-  o.method = get_string(options, "method", "harmonic") == "lbs" ? io::RetargetMethod::Lbs : io::RetargetMethod::Harmonic;
-  HarmonicRetargetOptions& h = o.harmonic;
-  h.map.singularities.count = get_int(options, "num_singularities", h.map.singularities.count);
-  h.map.singularities.offset = get_number(options, "offset", h.map.singularities.offset);
-  h.map.num_collocation = get_int(options, "num_collocation", h.map.num_collocation);
-  h.w_affine = get_number(options, "w_affine", h.w_affine);
-  h.w_position = get_number(options, "w_position", h.w_position);
-  h.w_smooth = get_number(options, "w_smooth", h.w_smooth);
-  h.w_bone = get_number(options, "w_bone", h.w_bone);
-  h.bone_iterations = get_int(options, "bone_iterations", h.bone_iterations);
-  h.surface_descriptors = get_int(options, "surface_descriptors", h.surface_descriptors);
-  h.anchor_joint = get_string(options, "anchor_joint", h.anchor_joint);
-  auto session = std::make_unique<io::RetargetSession>();
+  app::RetargetJobOptions o;
+  if (Status os = read_options(options, app::retarget_options(), &o); !os.ok()) return status_object(os);
+  auto session = std::make_unique<app::RetargetJob>();
   const Status st = session->prepare(s.asset, t.asset, joints, map, o, js_progress(progress));
   if (!st.ok()) return status_object(st);
   emscripten::val out = status_object(st);
@@ -111,7 +95,7 @@ emscripten::val retarget_export_glb(int id, emscripten::val positions) {
   auto it = retarget_sessions().find(id);
   if (it == retarget_sessions().end())
     return status_object(Status::error(StatusCode::InvalidArgument, "unknown retarget session"));
-  const io::RetargetSession& s = *it->second.session;
+  const app::RetargetJob& s = *it->second.session;
   const Eigen::MatrixXd all = to_matrix(positions, 3);
   const int nv = static_cast<int>(s.target_rest().rows());
   if (nv == 0 || all.rows() % nv != 0 || all.rows() / nv > s.num_frames())
@@ -133,8 +117,9 @@ bool retarget_dispose(int id) { return retarget_sessions().erase(id) > 0; }
 }  // namespace mm::wasm
 
 EMSCRIPTEN_BINDINGS(meshmorph_retarget) {
-  emscripten::function("retargetPrepare", &mm::wasm::retarget_prepare);
-  emscripten::function("retargetFrames", &mm::wasm::retarget_frames);
-  emscripten::function("retargetExportGlb", &mm::wasm::retarget_export_glb);
-  emscripten::function("retargetDispose", &mm::wasm::retarget_dispose);
+  using namespace mm::wasm;
+  bind<&retarget_prepare>("retargetPrepare");
+  bind<&retarget_frames>("retargetFrames");
+  bind<&retarget_export_glb>("retargetExportGlb");
+  bind<&retarget_dispose>("retargetDispose");
 }

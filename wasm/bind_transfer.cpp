@@ -5,9 +5,8 @@
 //   poseTransfer(refPositions (#V'·3), refIndices (#F'·3), srcPositions (#V·3), srcIndices (#F·3),
 //                landmarks (Int32Array/Array of 2p: r0, s0, r1, s1, ...; empty for same connectivity),
 //                options?, progress?: (stage, fraction) => boolean, cagePositions?, cageIndices?)
-//     options (C++ field names, missing = default): {method: "yin"|"kovnatsky"|"levy",
-//       num_low_frequencies, num_eigenpairs, lambda1, lambda2, max_iterations, tolerance,
-//       num_coupled, mu, cage_vertices, cage_resolution, placement: "reference"|"source"}
+//     options: any option of the transfer job's schema (app/transfer_job.h; optionSchema("transfer")),
+//       missing = default, unknown keys are an error
 //     → {ok, positions: Float64Array (#V·3), gamma: Float64Array (k·k, row-major), k,
 //        gammaDominance, iterations, converged, couplingIterations, cagePositions: Float64Array,
 //        cageRest: Float64Array, cageIndices: Uint32Array, energy: Float64Array,
@@ -23,7 +22,8 @@
 
 #include "convert.h"
 #include "metrics/transfer_metrics.h"
-#include "transfer/pose_transfer.h"
+#include "app/transfer_job.h"
+#include "guard.h"
 
 namespace mm::wasm {
 
@@ -33,7 +33,7 @@ namespace {
 
 val pose_transfer_js(val ref_positions, val ref_indices, val src_positions, val src_indices, val landmarks,
                      val options, val progress, val cage_positions, val cage_indices) {
-  try {
+  {
     const Mesh ref{to_matrix(ref_positions), to_index_matrix(ref_indices)};
     const Mesh src{to_matrix(src_positions), to_index_matrix(src_indices)};
     const std::vector<int> flat = to_int_vector(landmarks);
@@ -42,21 +42,7 @@ val pose_transfer_js(val ref_positions, val ref_indices, val src_positions, val 
     std::vector<LandmarkPair> pairs;
     for (size_t i = 0; i + 1 < flat.size(); i += 2) pairs.push_back({flat[i], flat[i + 1]});
     PoseTransferOptions opt;
-    const std::string method = get_string(options, "method", "yin");
-    if (!parse_transfer_method(method, &opt.method))
-      return status_object(Status::error(StatusCode::InvalidArgument, "method must be yin, kovnatsky or levy"));
-    opt.num_low_frequencies = get_int(options, "num_low_frequencies", opt.num_low_frequencies);
-    opt.num_eigenpairs = get_int(options, "num_eigenpairs", opt.num_eigenpairs);
-    opt.solver.lambda1 = get_number(options, "lambda1", opt.solver.lambda1);
-    opt.solver.lambda2 = get_number(options, "lambda2", opt.solver.lambda2);
-    opt.solver.max_iterations = get_int(options, "max_iterations", opt.solver.max_iterations);
-    opt.solver.tolerance = get_number(options, "tolerance", opt.solver.tolerance);
-    opt.coupling.num_coupled = get_int(options, "num_coupled", opt.coupling.num_coupled);
-    opt.coupling.mu = get_number(options, "mu", opt.coupling.mu);
-    opt.cage.target_vertices = get_int(options, "cage_vertices", opt.cage.target_vertices);
-    opt.cage.resolution = get_int(options, "cage_resolution", opt.cage.resolution);
-    opt.placement = get_string(options, "placement", "reference") == "source" ? TransferPlacement::Source
-                                                                              : TransferPlacement::Reference;
+    if (Status os = read_options(options, app::transfer_options(), &opt); !os.ok()) return status_object(os);
     Mesh cage;
     const bool has_cage = !cage_positions.isUndefined() && !cage_positions.isNull();
     if (has_cage) cage = {to_matrix(cage_positions), to_index_matrix(cage_indices)};
@@ -84,12 +70,6 @@ val pose_transfer_js(val ref_positions, val ref_indices, val src_positions, val 
     ms.set("total", r.ms.total);
     out.set("ms", ms);
     return out;
-  } catch (const std::exception& e) {
-    val out = val::object();
-    out.set("ok", false);
-    out.set("code", std::string("Internal"));
-    out.set("message", std::string("pose transfer: ") + e.what());
-    return out;
   }
 }
 
@@ -109,8 +89,8 @@ val transfer_metrics_js(val a, val b, val indices) {
 }  // namespace
 
 EMSCRIPTEN_BINDINGS(meshmorph_transfer) {
-  emscripten::function("poseTransfer", &pose_transfer_js);
-  emscripten::function("transferMetrics", &transfer_metrics_js);
+  bind<&pose_transfer_js>("poseTransfer");
+  bind<&transfer_metrics_js>("transferMetrics");
 }
 
 }  // namespace mm::wasm

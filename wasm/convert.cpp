@@ -109,6 +109,35 @@ val status_object(const Status& s) {
   return o;
 }
 
+val exception_object(const std::string& what, const std::exception* e, bool out_of_memory) {
+  val o = val::object();
+  o.set("ok", false);
+  // OutOfMemory is a page-level code (web/src/errors.js); everything else escaping is a bug.
+  o.set("code", std::string(out_of_memory ? "OutOfMemory" : "Internal"));
+  std::string detail = e ? e->what() : "unknown exception";
+  if (detail.size() > 200) detail = detail.substr(0, 200) + "...";
+  o.set("message", out_of_memory ? what + ": out of memory (the input is too large for the browser's 4 GB)"
+                                 : what + ": internal error: " + detail);
+  return o;
+}
+
+Status read_js_option_value(const val& v, const std::string& key, app::OptionValue* out) {
+  if (v.isNumber()) *out = app::OptionValue::of_number(v.as<double>());
+  else if (v.isTrue() || v.isFalse()) *out = app::OptionValue::of_boolean(v.isTrue());
+  else if (v.isString()) *out = app::OptionValue::of_text(v.as<std::string>());
+  else return Status::error(StatusCode::InvalidArgument, "option " + key.substr(0, 60) + " must be a number, a string or a boolean");
+  return Status::success();
+}
+
+std::vector<std::string> js_object_keys(const val& obj) {
+  std::vector<std::string> keys;
+  if (obj.isUndefined() || obj.isNull() || obj.typeOf().as<std::string>() != "object") return keys;
+  const val k = val::global("Object").call<val>("keys", obj);
+  const int n = k["length"].as<int>();
+  for (int i = 0; i < n; ++i) keys.push_back(k[i].as<std::string>());
+  return keys;
+}
+
 Progress js_progress(const val& callback) {
   if (callback.isUndefined() || callback.isNull()) return Progress();
   return Progress([callback](const std::string& stage, double f) {

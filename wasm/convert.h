@@ -4,12 +4,14 @@
 #pragma once
 
 #include <cstdint>
+#include <exception>
 #include <string>
 #include <vector>
 
 #include <emscripten/val.h>
 #include <Eigen/Core>
 
+#include "app/option_schema.h"
 #include "common/progress.h"
 #include "common/status.h"
 
@@ -38,6 +40,26 @@ std::string get_string(const emscripten::val& obj, const char* name, const std::
 // { ok: true } or { ok: false, code: "InvalidMesh", message: "..." }. Bindings return an object
 // built on top of this (set more fields on it when ok).
 emscripten::val status_object(const Status& s);
+
+// {ok:false, code, message} for an exception that escaped a binding (guard.h).
+emscripten::val exception_object(const std::string& what, const std::exception* e, bool out_of_memory);
+
+// Options object → a job's options through its schema (app/*_job.h): every key must be an option
+// of the schema; undefined/null values keep the default. Errors name the option.
+Status read_js_option_value(const emscripten::val& v, const std::string& key, app::OptionValue* out);
+std::vector<std::string> js_object_keys(const emscripten::val& obj);
+template <class O>
+Status read_options(const emscripten::val& obj, const app::OptionSchema<O>& schema, O* o) {
+  for (const std::string& key : js_object_keys(obj)) {
+    const emscripten::val v = obj[key];
+    if (v.isUndefined() || v.isNull()) continue;
+    app::OptionValue value;
+    Status s = read_js_option_value(v, key, &value);
+    if (s.ok()) s = schema.set(*o, key, value);
+    if (!s.ok()) return s;
+  }
+  return Status::success();
+}
 
 // A Progress that calls `callback(stage, fraction)` (a JS function) and cancels when it returns
 // false. An undefined callback gives a no-op Progress.

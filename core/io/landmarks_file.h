@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "common/status.h"
-#include "spectral/landmarks.h"
+#include "mesh/correspondence.h"
 
 namespace mm::io {
 

@@ -16,5 +16,7 @@ list(APPEND MM_IO_SOURCES
   core/io/tinygltf_impl.cpp)
 list(APPEND MM_TEST_SOURCES tests/io_test.cpp tests/io_gltf_test.cpp)
 list(APPEND MM_IO_SOURCES core/io/info_report.cpp)  # owned by the lead: the `info` report shared by CLI and wasm
-include(core/io/animation_sources.cmake OPTIONAL)  # retarget: glTF skins/animations (issue 5)
+# glTF skins/animations (read into core/character types) and the morph-target animation writer.
+list(APPEND MM_IO_SOURCES core/io/gltf_animation.cpp core/io/gltf_animation_write.cpp core/io/joints_json.cpp)
+list(APPEND MM_TEST_SOURCES tests/gltf_animation_test.cpp)
 list(APPEND MM_IO_SOURCES core/io/landmarks_file.cpp)

@@ -49,7 +49,7 @@
 #include "common/status.h"
 #include "retarget/harmonic_map.h"
 #include "retarget/harmonic_synthesis.h"
-#include "retarget/joint_set.h"
+#include "character/joint_set.h"
 
 namespace mm {
 

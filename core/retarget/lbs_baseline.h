@@ -9,23 +9,12 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/StdVector>
 
 #include "common/status.h"
-#include "retarget/joint_set.h"
+#include "character/joint_set.h"
+#include "character/skinning.h"
 
 namespace mm {
-
-// Per-vertex influences: up to K (transform index, weight) pairs; unused slots have weight 0.
-struct SkinWeights {
-  Eigen::MatrixXi index;   // #V by K transform indices
-  Eigen::MatrixXd weight;  // #V by K weights, rows sum to 1
-};
-
-using Matrix4dList = std::vector<Eigen::Matrix4d, Eigen::aligned_allocator<Eigen::Matrix4d>>;
-
-// v' = Σ_k w_k M[index_k] · [v; 1]. V: #V by 3.
-Eigen::MatrixXd linear_blend_skinning(const Eigen::MatrixXd& V, const SkinWeights& W, const Matrix4dList& M);
 
 // A similarity x_s = s·R·x_t + t mapping target rest space onto source rest space.
 struct Similarity {

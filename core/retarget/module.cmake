@@ -2,7 +2,6 @@ list(APPEND MM_CORE_SOURCES
   core/retarget/mfs_kernel.cpp
   core/retarget/harmonic_map.cpp
   core/retarget/bone_correspondence.cpp
-  core/retarget/joint_set.cpp
   core/retarget/harmonic_synthesis.cpp
   core/retarget/harmonic_retarget.cpp
   core/retarget/lbs_baseline.cpp)

@@ -16,13 +16,9 @@
 #include <Eigen/Core>
 
 #include "common/status.h"
+#include "mesh/correspondence.h"
 
 namespace mm {
-
-struct LandmarkPair {
-  int reference = -1;  // vertex index on the reference mesh
-  int source = -1;     // vertex index on the source mesh
-};
 
 struct LandmarkOptions {
   int reference_rings = 3;   // k on the reference (paper 000 Sec. 5: always 3)

@@ -7,33 +7,24 @@
 
 #include "cli.h"
 #include "io/asset.h"
-#include "io/retarget_session.h"
+#include "app/retarget_job.h"
 #include "metrics/retarget_metrics.h"
 
 namespace {
 
-const char* kRetargetHelp = R"(usage: meshmorph retarget --source SRC.glb [--clip NAME] --target TGT [--target-joints J.json]
-                          [--joint-map M.json] --out OUT.glb [--frames a:b] [--method harmonic|lbs]
+const char* kRetargetUsage = R"(usage: meshmorph retarget --source SRC.glb --target TGT --out OUT.glb [--target-joints J.json]
+                          [--joint-map M.json] [--frames a:b] [options]
 
 Animates TGT (glTF/GLB with or without a skin, or OBJ/OFF/PLY) with a clip of the skinned,
 animated SRC, without rigging TGT (harmonic maps, paper 002). OUT.glb holds the target with one
 morph target per frame and an animation of their weights (plays in three.js and Blender); an
 OUT with .obj/.ply/.off writes one mesh file per frame (OUT_0000.obj, ...).
 
-  --clip NAME              source clip (default: the first); unknown names list the clips
   --target-joints J.json   {"joint name": [x, y, z], ...} with the source's joint names
                            (needed when TGT has no skin)
   --joint-map M.json       {"source joint": "target joint", ...} where names differ
-  --frames a:b             frame range [a, b) of the sampled clip (either side optional)
-  --fps F                  sampling rate of the clip (default 30)
-  --method harmonic|lbs    harmonic map (default) or the naive LBS baseline (Fig. 6 f)
-  --num-singularities N    MFS singularity points per character (default 260)
-  --num-collocation N      MFS collocation points per character (default 1500)
-  --offset X               offset surface distance, × bbox diagonal (default 0.04)
-  --w-position, --w-smooth, --w-bone, --w-affine   energy weights (defaults 10, 0.001, 1, 1)
-  --bone-iterations N      re-linearisations of the bone-length term (default 2)
-  --surface-descriptors N  target surface points with affine descriptors (default 400; 0 = joints only)
-  --anchor-joint NAME      joint whose (scaled) trajectory the target follows (default: shallowest)
+  --frames a:b             shorthand for --first-frame a --last-frame b (either side optional)
+options (app/retarget_job.h):
 )";
 
 bool read_text(const std::string& path, std::string* out) {
@@ -51,56 +42,39 @@ int run_retarget(const std::vector<std::string>& argv) {
   Status s = args.parse(argv, {"help"});
   if (!s.ok()) return cli::report("retarget", s);
   if (args.has("help")) {
-    std::cout << kRetargetHelp;
+    std::cout << kRetargetUsage << app::retarget_options().help();
     return 0;
   }
   const std::string src_path = args.get("source"), tgt_path = args.get("target"), out_path = args.get("out");
   if (src_path.empty() || tgt_path.empty() || out_path.empty())
     return cli::report("retarget", Status::error(StatusCode::InvalidArgument, "--source, --target and --out are required (see --help)"));
-  io::RetargetJobOptions opt;
-  opt.clip = args.get("clip");
-  opt.fps = args.get_double("fps", opt.fps, &s);
-  const std::string method = args.get("method", "harmonic");
-  if (method == "lbs") opt.method = io::RetargetMethod::Lbs;
-  else if (method != "harmonic")
-    return cli::report("retarget", Status::error(StatusCode::InvalidArgument, "--method must be harmonic or lbs"));
+  const auto& schema = app::retarget_options();
+  app::RetargetJobOptions opt;
+  if (!(s = cli::read_options(args, schema, &opt)).ok()) return cli::report("retarget", s);
   if (args.has("frames")) {
     const std::string r = args.get("frames");
     const auto colon = r.find(':');
-    try {
-      if (colon == std::string::npos) throw 0;
-      if (colon > 0) opt.first_frame = std::stoi(r.substr(0, colon));
-      if (colon + 1 < r.size()) opt.last_frame = std::stoi(r.substr(colon + 1));
-    } catch (...) {
-      return cli::report("retarget", Status::error(StatusCode::InvalidArgument, "--frames expects a:b, e.g. 0:30"));
-    }
+    const std::string a = colon == std::string::npos ? "" : r.substr(0, colon);
+    const std::string b = colon == std::string::npos ? "" : r.substr(colon + 1);
+    Status fs = colon == std::string::npos ? Status::error(StatusCode::InvalidArgument, "--frames expects a:b, e.g. 0:30")
+                                           : Status::success();
+    if (fs.ok() && !a.empty()) fs = schema.set(opt, "first_frame", app::OptionValue::of_text(a));
+    if (fs.ok() && !b.empty()) fs = schema.set(opt, "last_frame", app::OptionValue::of_text(b));
+    if (!fs.ok()) return cli::report("retarget", Status::error(fs.code, "--frames: " + fs.message));
   }
-  HarmonicRetargetOptions& h = opt.harmonic;
-  h.map.singularities.count = args.get_int("num-singularities", h.map.singularities.count, &s);
-  h.map.singularities.offset = args.get_double("offset", h.map.singularities.offset, &s);
-  h.map.num_collocation = args.get_int("num-collocation", h.map.num_collocation, &s);
-  h.w_position = args.get_double("w-position", h.w_position, &s);
-  h.w_smooth = args.get_double("w-smooth", h.w_smooth, &s);
-  h.w_bone = args.get_double("w-bone", h.w_bone, &s);
-  h.w_affine = args.get_double("w-affine", h.w_affine, &s);
-  h.bone_iterations = args.get_int("bone-iterations", h.bone_iterations, &s);
-  h.surface_descriptors = args.get_int("surface-descriptors", h.surface_descriptors, &s);
-  h.anchor_joint = args.get("anchor-joint");
-  if (!s.ok()) return cli::report("retarget", s);
   std::string joints_json, map_json;
   if (args.has("target-joints") && !read_text(args.get("target-joints"), &joints_json))
     return cli::report("retarget", Status::error(StatusCode::IoError, "cannot read " + args.get("target-joints")));
   if (args.has("joint-map") && !read_text(args.get("joint-map"), &map_json))
     return cli::report("retarget", Status::error(StatusCode::IoError, "cannot read " + args.get("joint-map")));
-  for (const auto& u : args.unused())
-    return cli::report("retarget", Status::error(StatusCode::InvalidArgument, "unknown option --" + u));
+  if (!(s = cli::check_unused(args)).ok()) return cli::report("retarget", s);
 
   io::LoadResult src = io::load_asset(src_path);
   if (!src.status.ok()) return cli::report("retarget", src.status);
   io::LoadResult tgt = io::load_asset(tgt_path);
   if (!tgt.status.ok()) return cli::report("retarget", tgt.status);
   const Progress progress = cli::terminal_progress();
-  io::RetargetSession session;
+  app::RetargetJob session;
   const auto t0 = std::chrono::steady_clock::now();
   s = session.prepare(src.asset, tgt.asset, joints_json, map_json, opt, progress.sub(0, 0.3));
   if (!s.ok()) return cli::report("retarget", s);
@@ -130,9 +104,9 @@ int run_retarget(const std::vector<std::string>& argv) {
   }
   const double pre_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
   const double frame_ms = std::chrono::duration<double, std::milli>(t2 - t1).count() / std::max<size_t>(1, frames.size());
-  std::cout << "retarget: clip '" << session.clip_name() << "', " << frames.size() << " frames, method " << method
+  std::cout << "retarget: clip '" << session.clip_name() << "', " << frames.size() << " frames, method " << (opt.method == app::RetargetMethod::Lbs ? "lbs" : "harmonic")
             << "; precompute " << static_cast<int>(pre_ms) << " ms, " << frame_ms << " ms per frame\n";
-  if (opt.method == io::RetargetMethod::Harmonic) {
+  if (opt.method == app::RetargetMethod::Harmonic) {
     const auto& H = session.harmonic();
     std::vector<Eigen::MatrixXd> joints;
     for (int k = 0; k < session.num_frames(); ++k) joints.push_back(H.retarget(session.source_frame(k)).joints);

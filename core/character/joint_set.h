@@ -1,4 +1,4 @@
-// Joints of a character at its calibration pose, and the matching of source joints to target
+// Joints of a character at its calibration pose (character tier: no file format, no algorithm), and the matching of source joints to target
 // joints (paper 002 Sec. 3: "a sparse set of joints inside the source and target calibration
 // shapes", from a skeleton or placed by the user).
 #pragma once
@@ -22,22 +22,6 @@ struct JointSet {
   int size() const { return static_cast<int>(names.size()); }
   int find(const std::string& name) const;  // index or -1
 };
-
-struct JointSetResult {
-  Status status;   // ParseError with the offending key when the JSON is malformed
-  JointSet joints;
-};
-
-// Parses {"name": [x, y, z], ...}. Joints come out sorted by name (JSON objects are unordered).
-// from_user is set.
-JointSetResult parse_joints_json(const std::string& text);
-
-// Parses a joint map {"source joint name": "target joint name", ...}.
-struct JointMapResult {
-  Status status;
-  std::map<std::string, std::string> source_to_target;
-};
-JointMapResult parse_joint_map_json(const std::string& text);
 
 struct JointPair {
   int source = -1;  // index in the source JointSet

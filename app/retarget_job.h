@@ -1,7 +1,7 @@
-// RetargetSession: the whole retargeting job on loaded files — source character and clip, target
-// (glTF with or without a skin, or a plain mesh with joints from JSON), harmonic or LBS method,
-// frames, and the GLB writer — shared by the CLI, the wasm binding and the bench so that they
-// stay thin. Precompute once (prepare), then frames in any order or batch.
+// The retarget job (paper 002): source character and clip, target (glTF with or without a skin,
+// or a plain mesh with joints from JSON), harmonic or LBS method, frames, and the animated GLB
+// (with the props' rigid motions) — shared by the CLI, the wasm binding and the bench so that
+// they stay thin. Precompute once (prepare), then frames in any order or batch.
 #pragma once
 
 #include <memory>
@@ -13,11 +13,13 @@
 #include "common/progress.h"
 #include "common/status.h"
 #include "io/asset.h"
+#include "app/option_schema.h"
+#include "character/animated_character.h"
 #include "io/gltf_animation.h"
 #include "retarget/harmonic_retarget.h"
 #include "retarget/lbs_baseline.h"
 
-namespace mm::io {
+namespace mm::app {
 
 enum class RetargetMethod {
   Harmonic,  // paper 002 (retarget/harmonic_retarget.h)
@@ -31,15 +33,19 @@ struct RetargetJobOptions {
   int last_frame = -1;              // -1 = to the end
   RetargetMethod method = RetargetMethod::Harmonic;
   HarmonicRetargetOptions harmonic; // method options (paper defaults, see harmonic_retarget.h)
-  SurfaceSelection surface = SurfaceSelection::Auto;  // which glTF primitives form each character
+  io::SurfaceSelection surface = io::SurfaceSelection::Auto;  // which glTF primitives form each character
+  bool props_follow = true;         // exported GLB: joints that carry props follow the surface (prop_tracks)
 };
 
-class RetargetSession {
+// Every option of the retarget job; defaults from RetargetJobOptions / HarmonicRetargetOptions.
+const OptionSchema<RetargetJobOptions>& retarget_options();
+
+class RetargetJob {
  public:
   // source: a skinned, animated glTF. target: glTF or mesh. target_joints_json: {"name": [x,y,z]}
   // (required when the target has no skin; overrides its skin otherwise). joint_map_json:
   // {"source joint": "target joint"} or "". Progress stages of the harmonic precompute.
-  Status prepare(const Asset& source, const Asset& target, const std::string& target_joints_json,
+  Status prepare(const io::Asset& source, const io::Asset& target, const std::string& target_joints_json,
                  const std::string& joint_map_json, const RetargetJobOptions& opt, const Progress& progress = {});
 
   int num_frames() const { return static_cast<int>(times_.size()); }
@@ -68,7 +74,7 @@ class RetargetSession {
 
  private:
   RetargetJobOptions opt_;
-  Asset target_asset_;
+  io::Asset target_asset_;
   AnimatedCharacter source_, target_;
   bool target_is_gltf_ = false;
   int clip_ = -1;
@@ -83,4 +89,4 @@ class RetargetSession {
   SkinWeights lbs_weights_;
 };
 
-}  // namespace mm::io
+}  // namespace mm::app

@@ -1,10 +1,11 @@
-#include "edit/edit_spec.h"
+#include "app/edit_spec.h"
 
 #include <cmath>
 #include <set>
 
 #include <nlohmann/json.hpp>
 
+#include "app/edit_job.h"
 #include "edit/selection.h"
 #include "mesh/mesh.h"
 
@@ -298,49 +299,31 @@ EditSpecResult parse_edit_spec(const std::string& json_text, const Eigen::Matrix
       spec.features = f.get<std::string>() == "scale" ? FeatureSize::Scale : FeatureSize::Keep;
     }
     if (j.contains("options")) {
+      // Every key is an edit option of the job's schema (app/edit_job.h), as in the CLI and the page.
       const EditSpecJson& o = j["options"];
-      LaplacianEditOptions& opt = spec.options;
-      if (!o.is_object() || !p.check_keys(o, {"method", "weights", "coherence_rings", "coherence_weight",
-                                              "condition_threshold", "displacement_scale",
-                                              "gradient_constraint_weight", "soft_constraint_weight", "handle_basis",
-                                              "rotated_coordinates", "finalize_refinements"},
-                                          "options")) {
-        out.status = p.status.ok() ? Status::error(StatusCode::ParseError, "options must be an object") : p.status;
+      if (!o.is_object()) {
+        out.status = Status::error(StatusCode::ParseError, "options must be an object");
         return out;
       }
-      auto str = [&](const char* key, const char* a, const char* b, bool* first) {
-        if (!o.contains(key)) return true;
-        const EditSpecJson& v = o[key];
-        if (!v.is_string() || (v.get<std::string>() != a && v.get<std::string>() != b))
-          return p.fail(StatusCode::ParseError, std::string("options.") + key + " must be \"" + a + "\" or \"" + b + "\"");
-        *first = v.get<std::string>() == a;
-        return true;
-      };
-      bool implicit = true, cot = true, per_edge = true;
-      bool ok = str("method", "implicit", "naive", &implicit) && str("weights", "cotangent", "uniform", &cot) &&
-                str("rotated_coordinates", "per_edge", "per_vertex", &per_edge);
-      opt.rotated_coordinates = per_edge ? RotatedCoordinates::PerEdge : RotatedCoordinates::PerVertex;
-      opt.method = implicit ? EditMethod::Implicit : EditMethod::NaiveLaplacian;
-      opt.weights = cot ? LaplacianWeights::Cotangent : LaplacianWeights::Uniform;
-      if (ok && o.contains("coherence_rings")) ok = p.integer(o["coherence_rings"], "options.coherence_rings", &opt.coherence_rings);
-      if (ok && o.contains("finalize_refinements"))
-        ok = p.integer(o["finalize_refinements"], "options.finalize_refinements", &opt.finalize_refinements);
-      const std::pair<const char*, double*> numbers[] = {
-          {"coherence_weight", &opt.coherence_weight},
-          {"condition_threshold", &opt.condition_threshold},
-          {"displacement_scale", &opt.displacement_scale},
-          {"gradient_constraint_weight", &opt.gradient_constraint_weight},
-          {"soft_constraint_weight", &opt.soft_constraint_weight}};
-      for (const auto& [key, dst] : numbers)
-        if (ok && o.contains(key)) ok = p.number(o[key], std::string("options.") + key, dst);
-      if (ok && o.contains("handle_basis")) {
-        if (!o["handle_basis"].is_boolean()) ok = p.fail(StatusCode::ParseError, "options.handle_basis must be true or false");
-        else opt.handle_basis = o["handle_basis"].get<bool>();
+      app::EditJobOptions jo{spec.options, spec.features};
+      for (auto it = o.begin(); it != o.end(); ++it) {
+        const EditSpecJson& v = it.value();
+        app::OptionValue value;
+        if (v.is_boolean()) value = app::OptionValue::of_boolean(v.get<bool>());
+        else if (v.is_number()) value = app::OptionValue::of_number(v.get<double>());
+        else if (v.is_string()) value = app::OptionValue::of_text(v.get<std::string>());
+        else {
+          out.status = Status::error(StatusCode::ParseError, "options." + it.key() + " must be a number, a string or true/false");
+          return out;
+        }
+        const Status s = app::edit_options().set(jo, it.key(), value);
+        if (!s.ok()) {
+          out.status = Status::error(StatusCode::ParseError, "edit spec: " + s.message);
+          return out;
+        }
       }
-      if (!ok) {
-        out.status = p.status;
-        return out;
-      }
+      spec.options = jo.editor;
+      spec.features = jo.features;
     }
   } catch (const std::exception& e) {
     // The accessors above check types; this is a last line so that nothing escapes the API.

@@ -1,14 +1,12 @@
-#include "retarget/joint_set.h"
+#include "character/joint_set.h"
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 
-#include <nlohmann/json.hpp>
-
 namespace mm {
 
-namespace retarget_detail {
+namespace joint_set_detail {
 
 std::string normalized_joint_name(const std::string& s) {
   std::string out;
@@ -26,61 +24,12 @@ std::string joined_names(const std::vector<std::string>& names, size_t limit = 1
   return s;
 }
 
-}  // namespace retarget_detail
+}  // namespace joint_set_detail
 
 int JointSet::find(const std::string& name) const {
   for (int i = 0; i < size(); ++i)
     if (names[i] == name) return i;
   return -1;
-}
-
-JointSetResult parse_joints_json(const std::string& text) {
-  JointSetResult r;
-  // Parsed without exceptions (the wasm build may have them off): discarded value on error.
-  const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) {
-    r.status = Status::error(StatusCode::ParseError,
-                             "joints file must be a JSON object {\"joint name\": [x, y, z], ...}");
-    return r;
-  }
-  if (j.empty()) {
-    r.status = Status::error(StatusCode::ParseError, "joints file has no joints");
-    return r;
-  }
-  r.joints.P.resize(static_cast<int>(j.size()), 3);
-  int i = 0;
-  for (auto it = j.begin(); it != j.end(); ++it, ++i) {  // nlohmann orders keys: deterministic
-    const auto& v = it.value();
-    bool ok = v.is_array() && v.size() == 3;
-    for (size_t k = 0; ok && k < 3; ++k) ok = v[k].is_number() && std::isfinite(v[k].get<double>());
-    if (!ok) {
-      r.status = Status::error(StatusCode::ParseError,
-                               "joint '" + it.key() + "' must be an array of 3 finite numbers");
-      return r;
-    }
-    r.joints.names.push_back(it.key());
-    for (int k = 0; k < 3; ++k) r.joints.P(i, k) = v[k].get<double>();
-  }
-  r.joints.from_user = true;
-  return r;
-}
-
-JointMapResult parse_joint_map_json(const std::string& text) {
-  JointMapResult r;
-  const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) {
-    r.status = Status::error(StatusCode::ParseError,
-                             "joint map must be a JSON object {\"source joint\": \"target joint\", ...}");
-    return r;
-  }
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    if (!it.value().is_string()) {
-      r.status = Status::error(StatusCode::ParseError, "joint map entry '" + it.key() + "' must be a string");
-      return r;
-    }
-    r.source_to_target[it.key()] = it.value().get<std::string>();
-  }
-  return r;
 }
 
 JointMatchResult match_joints(const JointSet& source, const JointSet& target,
@@ -96,13 +45,13 @@ JointMatchResult match_joints(const JointSet& source, const JointSet& target,
     if (s < 0) {
       r.status = Status::error(StatusCode::InvalidArgument,
                                "joint map names source joint '" + sname + "', which the source does not have (source joints: " +
-                                   retarget_detail::joined_names(source.names) + ")");
+                                   joint_set_detail::joined_names(source.names) + ")");
       return r;
     }
     if (t < 0) {
       r.status = Status::error(StatusCode::InvalidArgument,
                                "joint map names target joint '" + tname + "', which the target does not have (target joints: " +
-                                   retarget_detail::joined_names(target.names) + ")");
+                                   joint_set_detail::joined_names(target.names) + ")");
       return r;
     }
     if (target_of[s] >= 0 || source_of[t] >= 0) {
@@ -119,9 +68,9 @@ JointMatchResult match_joints(const JointSet& source, const JointSet& target,
   }
   for (int s = 0; s < source.size(); ++s) {
     if (target_of[s] >= 0) continue;
-    const std::string ns = retarget_detail::normalized_joint_name(source.names[s]);
+    const std::string ns = joint_set_detail::normalized_joint_name(source.names[s]);
     for (int t = 0; t < target.size(); ++t)
-      if (source_of[t] < 0 && retarget_detail::normalized_joint_name(target.names[t]) == ns) {
+      if (source_of[t] < 0 && joint_set_detail::normalized_joint_name(target.names[t]) == ns) {
         link(s, t);
         break;
       }
@@ -133,13 +82,13 @@ JointMatchResult match_joints(const JointSet& source, const JointSet& target,
     if (target.from_user) {
       r.status = Status::error(StatusCode::InvalidArgument,
                                "target joint" + std::string(unmatched.size() > 1 ? "s " : " ") +
-                                   retarget_detail::joined_names(unmatched) +
+                                   joint_set_detail::joined_names(unmatched) +
                                    " match no source joint; use the source's joint names (" +
-                                   retarget_detail::joined_names(source.names) + ") or a joint map");
+                                   joint_set_detail::joined_names(source.names) + ") or a joint map");
       return r;
     }
     r.warnings.push_back(std::to_string(unmatched.size()) + " target joints have no source joint: " +
-                         retarget_detail::joined_names(unmatched));
+                         joint_set_detail::joined_names(unmatched));
   }
   for (int s = 0; s < source.size(); ++s)
     if (target_of[s] >= 0) r.pairs.push_back({s, target_of[s]});
@@ -147,8 +96,8 @@ JointMatchResult match_joints(const JointSet& source, const JointSet& target,
     r.status = Status::error(StatusCode::InvalidArgument,
                              "only " + std::to_string(r.pairs.size()) + " source joints match target joints (need " +
                                  std::to_string(min_pairs) + "); source joints: " +
-                                 retarget_detail::joined_names(source.names) +
-                                 "; target joints: " + retarget_detail::joined_names(target.names));
+                                 joint_set_detail::joined_names(source.names) +
+                                 "; target joints: " + joint_set_detail::joined_names(target.names));
     return r;
   }
   return r;

@@ -1,20 +1,60 @@
-#include "io/retarget_session.h"
+#include "app/retarget_job.h"
 
 #include <algorithm>
 
+#include "character/prop_tracks.h"
 #include "io/gltf_document.h"
+#include "io/joints_json.h"
 
-namespace mm::io {
+namespace mm::app {
 
-Status RetargetSession::prepare(const Asset& source, const Asset& target, const std::string& target_joints_json,
+const OptionSchema<RetargetJobOptions>& retarget_options() {
+  using O = RetargetJobOptions;
+  static const OptionSchema<O> schema = [] {
+    OptionSchema<O> s("retarget", "animate a target mesh with a source character's clip (harmonic maps, paper 002)");
+    s.text("clip", [](O& o) -> std::string& { return o.clip; }, "source clip name (\"\" = the first clip)");
+    s.number("fps", [](O& o) -> double& { return o.fps; }, 1e-3, 1000, "sampling rate of the clip");
+    s.integer("first_frame", [](O& o) -> int& { return o.first_frame; }, 0, kUnbounded, "first frame of the sampled clip");
+    s.integer("last_frame", [](O& o) -> int& { return o.last_frame; }, -1, kUnbounded, "end of the frame range, exclusive (-1 = to the end)");
+    s.choice<RetargetMethod>("method", [](O& o) -> RetargetMethod& { return o.method; },
+                             {{"harmonic", RetargetMethod::Harmonic}, {"lbs", RetargetMethod::Lbs}},
+                             "harmonic map (paper 002) or the naive LBS baseline (Fig. 6 f)");
+    s.choice<io::SurfaceSelection>("surface", [](O& o) -> io::SurfaceSelection& { return o.surface; },
+                                   {{"auto", io::SurfaceSelection::Auto}, {"skinned", io::SurfaceSelection::SkinnedOnly},
+                                    {"all", io::SurfaceSelection::All}},
+                                   "which glTF primitives form each character");
+    s.integer("num_singularities", [](O& o) -> int& { return o.harmonic.map.singularities.count; }, 4, 20000,
+              "MFS singularity points per character (Sec. 4.3: 260)");
+    s.integer("num_collocation", [](O& o) -> int& { return o.harmonic.map.num_collocation; }, 4, 200000,
+              "MFS collocation points per character");
+    s.number("offset", [](O& o) -> double& { return o.harmonic.map.singularities.offset; }, 1e-6, 1,
+             "offset surface distance for the singularities, × bbox diagonal");
+    s.number("w_position", [](O& o) -> double& { return o.harmonic.w_position; }, 0, kUnbounded, "λ_position, anchor trajectory weight");
+    s.number("w_smooth", [](O& o) -> double& { return o.harmonic.w_smooth; }, 0, kUnbounded, "λ_smooth, Hessian energy weight");
+    s.number("w_bone", [](O& o) -> double& { return o.harmonic.w_bone; }, 0, kUnbounded, "λ_bone, bone-length preservation weight");
+    s.number("w_affine", [](O& o) -> double& { return o.harmonic.w_affine; }, 0, kUnbounded, "λ_affine, Jacobian match weight");
+    s.integer("bone_iterations", [](O& o) -> int& { return o.harmonic.bone_iterations; }, 0, 100,
+              "re-linearisations of the bone-length term");
+    s.integer("surface_descriptors", [](O& o) -> int& { return o.harmonic.surface_descriptors; }, 0, 100000,
+              "target surface points with affine descriptors (0 = joints only)");
+    s.text("anchor_joint", [](O& o) -> std::string& { return o.harmonic.anchor_joint; },
+           "joint whose (scaled) trajectory the target follows (\"\" = the shallowest)");
+    s.boolean("props_follow", [](O& o) -> bool& { return o.props_follow; },
+              "exported GLB: props under joints (weapons, hats) follow the surface");
+    return s;
+  }();
+  return schema;
+}
+
+Status RetargetJob::prepare(const io::Asset& source, const io::Asset& target, const std::string& target_joints_json,
                                 const std::string& joint_map_json, const RetargetJobOptions& opt,
                                 const Progress& progress) {
   opt_ = opt;
   warnings_.clear();
   times_.clear();
-  CharacterOptions co;
+  io::CharacterOptions co;
   co.surface = opt.surface;
-  CharacterResult src = animated_character(source, co);
+  io::CharacterResult src = io::animated_character(source, co);
   if (!src.status.ok()) return Status{src.status.code, "source: " + src.status.message};
   source_ = std::move(src.character);
   for (auto& w : src.warnings) warnings_.push_back("source: " + w);
@@ -35,10 +75,10 @@ Status RetargetSession::prepare(const Asset& source, const Asset& target, const 
 
   // Target surface and joints.
   target_asset_ = target;
-  target_is_gltf_ = gltf_model(target) != nullptr;
+  target_is_gltf_ = io::gltf_model(target) != nullptr;
   JointSet target_joints;
   if (target_is_gltf_) {
-    CharacterResult tr = animated_character(target, co);
+    io::CharacterResult tr = io::animated_character(target, co);
     if (!tr.status.ok()) return Status{tr.status.code, "target: " + tr.status.message};
     target_ = std::move(tr.character);
     for (auto& w : tr.warnings) warnings_.push_back("target: " + w);
@@ -50,7 +90,7 @@ Status RetargetSession::prepare(const Asset& source, const Asset& target, const 
     target_F_ = target.F_raw;
   }
   if (!target_joints_json.empty()) {
-    JointSetResult jr = parse_joints_json(target_joints_json);
+    io::JointSetResult jr = io::parse_joints_json(target_joints_json);
     if (!jr.status.ok()) return Status{jr.status.code, "target joints: " + jr.status.message};
     target_joints = std::move(jr.joints);
   }
@@ -60,7 +100,7 @@ Status RetargetSession::prepare(const Asset& source, const Asset& target, const 
                          "using the source's joint names");
   std::map<std::string, std::string> map;
   if (!joint_map_json.empty()) {
-    JointMapResult mr = parse_joint_map_json(joint_map_json);
+    io::JointMapResult mr = io::parse_joint_map_json(joint_map_json);
     if (!mr.status.ok()) return mr.status;
     map = std::move(mr.source_to_target);
   }
@@ -84,9 +124,9 @@ Status RetargetSession::prepare(const Asset& source, const Asset& target, const 
   return Status::success();
 }
 
-Eigen::MatrixXd RetargetSession::source_frame(int k) const { return pose_at(source_, clip_, times_[k]); }
+Eigen::MatrixXd RetargetJob::source_frame(int k) const { return pose_at(source_, clip_, times_[k]); }
 
-Status RetargetSession::frame(int k, Eigen::MatrixXd* V) const {
+Status RetargetJob::frame(int k, Eigen::MatrixXd* V) const {
   if (k < 0 || k >= num_frames()) return Status::error(StatusCode::InvalidArgument, "frame index out of range");
   if (opt_.method == RetargetMethod::Harmonic) {
     RetargetFrame f = harmonic_.retarget(source_frame(k));
@@ -100,7 +140,7 @@ Status RetargetSession::frame(int k, Eigen::MatrixXd* V) const {
   return Status::success();
 }
 
-Status RetargetSession::frames(int first, int count, std::vector<Eigen::MatrixXd>* out, const Progress& progress) const {
+Status RetargetJob::frames(int first, int count, std::vector<Eigen::MatrixXd>* out, const Progress& progress) const {
   out->clear();
   for (int k = first; k < first + count && k < num_frames(); ++k) {
     if (!progress.update("frames", count > 0 ? double(k - first) / count : 1.0)) return cancelled_status("frames");
@@ -113,11 +153,13 @@ Status RetargetSession::frames(int first, int count, std::vector<Eigen::MatrixXd
   return Status::success();
 }
 
-Status RetargetSession::write_glb(const std::vector<Eigen::MatrixXd>& frames, const std::vector<double>& times,
+Status RetargetJob::write_glb(const std::vector<Eigen::MatrixXd>& frames, const std::vector<double>& times,
                                   std::vector<uint8_t>* bytes) const {
-  MorphAnimationOptions mo;
+  io::MorphAnimationOptions mo;
   mo.animation_name = clip_name_.empty() ? "retarget" : clip_name_;
-  return write_morph_animation(target_asset_, target_character(), frames, times, bytes, mo);
+  std::vector<NodeTrack> tracks;
+  if (opt_.props_follow && target_is_gltf_) tracks = prop_tracks(target_, frames);
+  return io::write_morph_animation(target_asset_, target_character(), frames, times, bytes, mo, tracks);
 }
 
-}  // namespace mm::io
+}  // namespace mm::app

@@ -8,12 +8,8 @@
 //     "fixed":   SELECTION,                       optional
 //     "handles": [ { "select": SELECTION, TRANSFORM }, ... ],      at least one
 //     "features": "keep" | "scale",               Eq. 9 / Eq. 10 (default "keep")
-//     "options": { "method": "implicit" | "naive", "weights": "cotangent" | "uniform",
-//                  "coherence_rings": 2, "coherence_weight": 1, "condition_threshold": 2e5,
-//                  "displacement_scale": 0.2, "gradient_constraint_weight": 0,
-//                  "soft_constraint_weight": 0, "handle_basis": true,
-//                  "rotated_coordinates": "per_edge"|"per_vertex", "finalize_refinements": 1 }
-//                                                                     (LaplacianEditOptions)
+//     "options": { "method": "naive", "coherence_rings": 1, ... }      any option of the edit
+//                                  job's schema (app/edit_job.h; `meshmorph edit --help` lists them)
 //   }
 //   SELECTION: [i, j, ...]  or  { "indices": [...], "spheres": [{"center": [x,y,z] | "vertex": i,
 //              "radius": r | "radius_rel": r}], "boxes": [{"min": [..], "max": [..]}],
