@@ -3,15 +3,15 @@
 // - The wasm module is imported from the CMake build (`@meshmorph/wasm/meshmorph_web.mjs`,
 //   default build/wasm/wasm, override with MM_WASM_DIR). Its glue locates the .wasm with
 //   `new URL('meshmorph_web.wasm', import.meta.url)`, which Vite turns into a hashed asset.
-// - Gallery samples (web/src/samples.js) are served from data/ by the dev server and copied
+// - Gallery samples (web/src/lib/samples.js) are served from data/ by the dev server and copied
 //   into the build under samples/, with data/licenses/.
 // - COOP/COEP headers make the page crossOriginIsolated, so SharedArrayBuffer exists and
-//   Cancel can stop a computation without killing the worker (see web/src/client.js).
+//   Cancel can stop a computation without killing the worker (see web/src/lib/client.js).
 import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { defineConfig } from 'vite';
-import { sampleFiles } from './src/samples.js';
+import { sampleFiles } from './src/lib/samples.js';
 
 const webDir = path.dirname(fileURLToPath(import.meta.url));
 const repoDir = path.resolve(webDir, '..');

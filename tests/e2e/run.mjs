@@ -2,10 +2,12 @@
 // (headless, WebGL through SwiftShader) against the built page (build/web-dist; rebuilt here
 // when missing, older than web/ or the wasm module, or MM_E2E_BUILD=1) served by `vite
 // preview` on 127.0.0.1 and a free port.
-// Screenshots go to build/e2e/. Prints "N passed, M failed"; exit code 1 on any failure.
+// Screenshots (and the exported GLB) go to build/e2e/ or MM_E2E_OUT. Prints "N passed, M
+// failed"; exit code 1 on any failure.
 //
 // Usage: node tests/e2e/run.mjs [--headed] [--only <substring>]
-// Env:   MM_CHROMIUM (default /usr/bin/chromium), MM_E2E_BUILD=1 (rebuild the page first)
+// Env:   MM_CHROMIUM (default /usr/bin/chromium), MM_E2E_BUILD=1 (rebuild the page first),
+//        MM_E2E_OUT (output directory), MM_WASM_DIR (the wasm build, as for vite.config.js)
 import fs from 'node:fs';
 import net from 'node:net';
 import os from 'node:os';
@@ -17,10 +19,10 @@ import { build, preview } from 'vite';
 const repoDir = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const configFile = path.join(repoDir, 'web/vite.config.js');
 const distDir = path.join(repoDir, 'build/web-dist');
-const shotDir = path.join(repoDir, 'build/e2e');
+const shotDir = path.resolve(process.env.MM_E2E_OUT || path.join(repoDir, 'build/e2e'));
 const args = process.argv.slice(2);
 const only = args.includes('--only') ? args[args.indexOf('--only') + 1] : null;
-const background = [0x1d, 0x22, 0x30]; // web/src/viewer.js backgroundColor
+const background = [0x1d, 0x22, 0x30]; // web/src/view/viewer.js backgroundColor
 
 // ---- helpers
 
@@ -330,6 +332,51 @@ it('gallery: every sample loads and renders', async ({ page }) => {
     if (stats.foreground < 0.02) failed.push(`${id}: blank canvas`);
   }
   check(failed.length === 0, failed.join('; '));
+});
+
+it('vertex picking: the real mouse over the mesh shows the vertex, a click pins it', async ({ page }) => {
+  await pickSample(page, 'armadillo');
+  const box = await page.locator('#view').boundingBox();
+  // The mesh is framed in the middle of the view: try points around the centre until the
+  // pointer is over the surface.
+  const offsets = [[0, 0], [0, 0.08], [0, -0.08], [0.06, 0], [-0.06, 0], [0.03, 0.2], [-0.03, -0.2]];
+  let pick = null;
+  let at = null;
+  for (const [dx, dy] of offsets) {
+    at = { x: box.x + box.width * (0.5 + dx), y: box.y + box.height * (0.5 + dy) };
+    await page.mouse.move(at.x, at.y, { steps: 5 });
+    pick = await page.waitForFunction(() => window.__meshmorph.state.pick, null, { timeout: 3000 })
+      .then((handle) => handle.jsonValue(), () => null);
+    if (pick) break;
+  }
+  check(pick, 'moving the mouse over the middle of the view picked no vertex');
+  const mesh = await page.evaluate(() => {
+    const { state } = window.__meshmorph;
+    return { raw: state.mesh.rawVertices, welded: state.mesh.weldedVertices, mapped: state.mesh.toWelded[state.pick.vertex] };
+  });
+  check(Number.isInteger(pick.vertex) && pick.vertex >= 0 && pick.vertex < mesh.raw, `vertex ${pick.vertex} of ${mesh.raw}`);
+  check(pick.welded === mesh.mapped && pick.welded < mesh.welded, `welded index ${pick.welded}, toWelded says ${mesh.mapped}`);
+  check(pick.point.length === 3 && pick.point.every(Number.isFinite) && pick.distance > 0, `pick ${JSON.stringify(pick)}`);
+  const gap = Math.hypot(...pick.point.map((v, i) => v - pick.hit[i]));
+  check(gap < 0.05 * pick.distance, `the picked vertex is ${gap} from the hit point (ray length ${pick.distance})`);
+  const hoverText = await page.textContent('#pick-hover');
+  check(new RegExp(`vertex #${pick.welded} \\(-?[0-9.]+, -?[0-9.]+, -?[0-9.]+\\)`).test(hoverText), `panel shows: ${hoverText}`);
+  await nextFrame(page);
+  await shot(page, '10-pick-hover');
+
+  await page.mouse.down();
+  await page.mouse.up();
+  await page.waitForFunction(() => window.__meshmorph.state.pinned, null, { timeout: 3000 });
+  const pinned = await page.evaluate(() => window.__meshmorph.state.pinned);
+  check(pinned.vertex === pick.vertex, `clicked at the hovered vertex ${pick.vertex}, pinned ${pinned.vertex}`);
+  check((await page.textContent('#pick-pinned')).includes(`pinned: vertex #${pick.welded} (`), 'pinned vertex not shown in the panel');
+
+  // Off the mesh (a corner of the view): the hover pick goes, the pinned one stays.
+  await page.mouse.move(box.x + 8, box.y + box.height - 8, { steps: 5 });
+  await page.waitForFunction(() => window.__meshmorph.state.pick === null, null, { timeout: 3000 });
+  check(await page.isVisible('#pick-pinned'), 'the pinned vertex disappeared when the pointer left the mesh');
+  await nextFrame(page);
+  await shot(page, '10-pick-pinned');
 });
 
 // ---- runner

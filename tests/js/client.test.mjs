@@ -1,11 +1,11 @@
-// The main-thread client (web/src/client.js) against the real worker runtime, ops and wasm
+// The main-thread client (web/src/lib/client.js) against the real worker runtime, ops and wasm
 // bindings, hosted in node worker threads (node_worker.mjs): request ids, progress,
 // transfer, both cancel strategies, restoring state into a replacement worker, and
 // respawning a worker that fails to start or traps.
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import { Worker } from 'node:worker_threads';
-import { MeshMorphClient } from '../../web/src/client.js';
+import { MeshMorphClient } from '../../web/src/lib/client.js';
 import { dataBytes } from './wasm_module.mjs';
 
 const workerUrl = new URL('./node_worker.mjs', import.meta.url);

@@ -1,12 +1,12 @@
-// API tests of wasm/bind_edit.cpp through web/src/ops/edit.js — the functions the worker runs —
+// API tests of wasm/bind_edit.cpp through web/src/worker/ops/edit.js — the functions the worker runs —
 // with the node build of the module (node --test tests/js/; MM_WASM_DIR overrides the build
 // directory). The golden is the one the C++ suite checks natively and in wasm
 // (tests/edit_test.cpp, Edit.GoldenBarBend).
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
-import { MeshMorphError } from '../../web/src/errors.js';
-import { ops as meshOps } from '../../web/src/ops/mesh.js';
-import { ops as editOps } from '../../web/src/ops/edit.js';
+import { MeshMorphError } from '../../web/src/lib/errors.js';
+import { ops as meshOps } from '../../web/src/worker/ops/mesh.js';
+import { ops as editOps } from '../../web/src/worker/ops/edit.js';
 import { fileBuffers, makeContext, readGolden } from './wasm_module.mjs';
 
 function expectCode(fn, code, messagePattern) {

@@ -1,10 +1,10 @@
-// API tests of wasm/bind_mesh.cpp through web/src/ops/mesh.js — the functions the worker runs —
+// API tests of wasm/bind_mesh.cpp through web/src/worker/ops/mesh.js — the functions the worker runs —
 // with the node build of the module. Run: node --test tests/js/ (MM_WASM_DIR overrides the
 // build directory).
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
-import { MeshMorphError } from '../../web/src/errors.js';
-import { ops } from '../../web/src/ops/mesh.js';
+import { MeshMorphError } from '../../web/src/lib/errors.js';
+import { ops } from '../../web/src/worker/ops/mesh.js';
 import { dataBytes, fileBuffers, makeContext, readGolden } from './wasm_module.mjs';
 
 const encoder = new TextEncoder();

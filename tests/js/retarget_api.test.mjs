@@ -1,12 +1,12 @@
-// API tests of wasm/bind_retarget.cpp through web/src/ops/retarget.js — the functions the worker
+// API tests of wasm/bind_retarget.cpp through web/src/worker/ops/retarget.js — the functions the worker
 // runs — with the node build of the module: Fox (Walk) → wolf0 with placed joints (paper 002).
 // Run: node --test tests/js/ (MM_WASM_DIR overrides the build directory).
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
-import { MeshMorphError } from '../../web/src/errors.js';
-import { ops } from '../../web/src/ops/retarget.js';
+import { MeshMorphError } from '../../web/src/lib/errors.js';
+import { ops } from '../../web/src/worker/ops/retarget.js';
 import { dataBytes, makeContext } from './wasm_module.mjs';
 
 const jointsJson = new TextDecoder().decode(dataBytes('joints/wolf0_joints.json'));

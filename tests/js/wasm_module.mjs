@@ -1,6 +1,6 @@
 // Shared by the JS API tests: loads the node build of the wasm module (meshmorph_node.cjs from
 // MM_WASM_DIR, default build/wasm/wasm) once per test file and builds the same `ctx` the
-// worker hands to its ops (web/src/worker.js), so the tests call the bindings exactly as the
+// worker hands to its ops (web/src/worker/worker.js), so the tests call the bindings exactly as the
 // page does.
 import fs from 'node:fs';
 import { createRequire } from 'node:module';

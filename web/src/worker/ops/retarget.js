@@ -2,7 +2,7 @@
 // once, then frames in batches (each batch reports progress and can be cancelled), then export.
 // The session stays in ctx.state.retarget until retargetDispose; playback in the page swaps the
 // position attribute per frame (the UI issue), so frames come back as one Float32Array per batch.
-import { MeshMorphError, unwrap } from '../errors.js';
+import { MeshMorphError, unwrap } from '../../lib/errors.js';
 
 function toBytes(value) {
   if (value instanceof Uint8Array) return value;

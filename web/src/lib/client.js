@@ -1,7 +1,7 @@
 // Main-thread side of the worker protocol (protocol.js): request ids, pending[id] =
 // {resolve, reject}, progress callbacks, cancel, and replacing a worker that failed.
 //
-// Cancel strategy (tested by tests/e2e/run.mjs, both ways):
+// Cancel strategy (tested by tests/e2e/run.mjs and tests/js/client.test.mjs, both ways):
 //  1. cooperative — when crossOriginIsolated (vite serves COOP/COEP), a SharedArrayBuffer
 //     flag is shared with the worker; cancel(id) stores id there, the core's progress sink
 //     sees it and the op ends with code Cancelled. Cheap: the worker keeps its loaded meshes.
@@ -12,7 +12,7 @@
 //     here, before any new request runs.
 // The same replacement happens when the worker fails to initialise (up to `maxInitAttempts`)
 // or reports a fatal error (a wasm trap).
-import { MeshMorphError } from './errors.js';
+import { MeshMorphError, toMeshMorphError } from './errors.js';
 import { cloneBuffers, transferList } from './protocol.js';
 
 export class MeshMorphClient {
@@ -67,7 +67,7 @@ export class MeshMorphClient {
           worker.onerror = (e) => this.crashed(worker, e.message || 'worker error');
           resolve(message);
         } else if (message.type === 'error') {
-          reject(new MeshMorphError(message.code, message.message));
+          reject(toMeshMorphError(message));
         }
       };
       worker.onerror = (e) => {
@@ -154,7 +154,7 @@ export class MeshMorphClient {
         }
         if (!entry) return;
         this.settle(message.id);
-        entry.reject(new MeshMorphError(message.code, message.message));
+        entry.reject(toMeshMorphError(message));
         break;
       default:
         break;

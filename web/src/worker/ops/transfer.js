@@ -1,6 +1,6 @@
 // Worker ops of the transfer module (bindings in wasm/bind_transfer.cpp): spectral pose transfer
-// (paper 000) between two loaded meshes, and the comparison metrics. Registered by the worker
-// like every `ops` export of web/src/ops/*.js.
+// (paper 000) between two loaded meshes, and the comparison metrics. Listed in
+// worker/ops/index.js like every ops file.
 //
 // transfer: options {referenceSlot = 'reference', sourceSlot = 'main', landmarks?: [[r, s], ...],
 //   method?: 'yin'|'kovnatsky'|'levy', lambda1?, lambda2?, num_low_frequencies?, num_eigenpairs?,
@@ -12,7 +12,7 @@
 // compare: options {slotA = 'main', slotB = 'reference'} (same vertex order)
 //   → info {vertexErrorMean, vertexErrorMax, laplacianChange, edgeDistortionMean,
 //           edgeDistortionMax, flippedFaces}
-import { MeshMorphError, unwrap } from '../errors.js';
+import { MeshMorphError, unwrap } from '../../lib/errors.js';
 import { meshInSlot } from './mesh.js';
 
 function flatLandmarks(pairs) {

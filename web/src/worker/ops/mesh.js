@@ -1,7 +1,7 @@
 // Worker ops of the mesh module (bindings in wasm/bind_mesh.cpp): load a file, report, the
-// eigenbasis, export. The worker registers every `ops` export of web/src/ops/*.js; node tests
-// (tests/js/) import this file and call the same functions with the node build of the module,
-// so the page and the tests exercise one code path.
+// eigenbasis, export. Listed in worker/ops/index.js like every ops file; node tests (tests/js/)
+// import this file and call the same functions with the node build of the module, so the page
+// and the tests exercise one code path.
 //
 // An op is `(ctx, options, buffers) => {info, buffers}` where
 //   ctx.module   the Emscripten module (meshmorph_web or meshmorph_node)
@@ -11,7 +11,7 @@
 //                core's Progress sink, which stops with code Cancelled
 // Options use the C++ field names (a missing field means the core's default). Returned
 // typed arrays are transferred to the caller.
-import { MeshMorphError, unwrap } from '../errors.js';
+import { MeshMorphError, unwrap } from '../../lib/errors.js';
 
 export const defaultSlot = 'main';
 

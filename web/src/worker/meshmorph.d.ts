@@ -1,9 +1,9 @@
-// Types of the wasm module's JS API (wasm/bind_*.cpp), the worker protocol (protocol.js) and
+// Types of the wasm module's JS API (wasm/bind_*.cpp), the worker protocol (lib/protocol.js) and
 // the mesh ops (ops/mesh.js). Documentation only: the page is plain JS, editors and
 // reviewers read this. Engineers adding bind_<module>.cpp / ops/<module>.js extend
 // MeshMorphModule and add their op types below.
 
-/** Every binding failure; the JS wrapper (errors.js unwrap) throws MeshMorphError with it. */
+/** Every binding failure; the JS wrapper (lib/errors.js unwrap) throws MeshMorphError with it. */
 export interface Failure {
   ok: false;
   /** StatusCode name (core/common/status.h): InvalidArgument, InvalidMesh, IoError, ParseError,
@@ -88,7 +88,7 @@ export interface MeshMorphModule {
   }>;
 }
 
-// ---- worker protocol (protocol.js)
+// ---- worker protocol (lib/protocol.js)
 
 export type Buffers = Record<string, ArrayBufferView | ArrayBuffer>;
 export type ToWorker =

@@ -25,3 +25,11 @@ export function cloneBuffers(buffers) {
   }
   return out;
 }
+
+// The 'error' message for request `id` (null: not about one request) from a MeshMorphError;
+// the client turns it back into one with toMeshMorphError (errors.js).
+export function errorMessage(id, error) {
+  const message = { type: 'error', id, code: error.code, message: error.message };
+  if (error.fatal) message.fatal = true;
+  return message;
+}

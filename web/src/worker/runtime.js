@@ -1,9 +1,9 @@
-// The worker's message handling, independent of how it is hosted: web/src/worker.js runs it
+// The worker's message handling, independent of how it is hosted: worker/worker.js runs it
 // in a browser Web Worker, tests/js/node_worker.mjs in a node worker thread (so the client's
 // protocol, cancel and respawn logic is tested in node with the real ops and bindings).
 //
 // Cancel: a running wasm call never sees a later postMessage (the worker's event loop is
-// blocked inside it), so cancellation is driven by the main thread (client.js):
+// blocked inside it), so cancellation is driven by the main thread (lib/client.js):
 //  - cooperative, when the page is crossOriginIsolated: the client writes the request id into
 //    a SharedArrayBuffer flag (sent with 'init'); our progress callback reads it with Atomics
 //    on every core progress update and answers "stop", and the core returns Cancelled. The
@@ -12,15 +12,15 @@
 //    factorization between two progress updates) the client terminates the worker and starts
 //    a new one, replaying the requests marked to restore its state (the current mesh's load).
 // A 'cancel' message is still honoured for requests queued behind the running one.
-import { MeshMorphError } from './errors.js';
-import { transferList } from './protocol.js';
+import { MeshMorphError } from '../lib/errors.js';
+import { errorMessage, transferList } from '../lib/protocol.js';
 
 // Progress messages are throttled: the core reports on every Lanczos step (hundreds per
 // second); a progress bar needs ~20 updates per second and postMessage is not free.
 const progressIntervalMs = 50;
 
-// loadModule: () => Promise<Emscripten module>; opFiles: {file: {ops}} (every `ops` export
-// of web/src/ops/*.js); post: (message, transferList) => void.
+// loadModule: () => Promise<Emscripten module>; opFiles: {file: {ops}} (the ops list,
+// worker/ops/index.js); post: (message, transferList) => void.
 export function createWorkerRuntime({ loadModule, opFiles, post }) {
   let ctx = null;
   let ops = null;
@@ -37,7 +37,7 @@ export function createWorkerRuntime({ loadModule, opFiles, post }) {
       ctx = { module, state: { meshes: new Map() }, progress: () => true };
       send({ type: 'ready', ops: [...ops.keys()], cooperativeCancel: Boolean(cancelFlag) });
     } catch (e) {
-      send({ type: 'error', id: null, code: 'InitFailed', message: `could not start the geometry module: ${e?.message || e}`, fatal: true });
+      send(errorMessage(null, new MeshMorphError('InitFailed', `could not start the geometry module: ${e?.message || e}`, { fatal: true })));
     }
   }
 
@@ -45,12 +45,12 @@ export function createWorkerRuntime({ loadModule, opFiles, post }) {
 
   function run({ id, op, options, buffers }) {
     if (cancelledIds.delete(id)) {
-      send({ type: 'error', id, code: 'Cancelled', message: 'cancelled before it started' });
+      send(errorMessage(id, new MeshMorphError('Cancelled', 'cancelled before it started')));
       return;
     }
     const entry = ops?.get(op);
     if (!ctx || !entry) {
-      send({ type: 'error', id, code: 'InvalidArgument', message: ctx ? `unknown op '${op}'` : 'worker is not initialised' });
+      send(errorMessage(id, new MeshMorphError('InvalidArgument', ctx ? `unknown op '${op}'` : 'worker is not initialised')));
       return;
     }
     let lastPost = -Infinity;
@@ -68,14 +68,7 @@ export function createWorkerRuntime({ loadModule, opFiles, post }) {
       const result = entry.fn(ctx, options || {}, buffers || {});
       send({ type: 'result', id, buffers: result.buffers || {}, info: result.info || {} }, result.buffers);
     } catch (e) {
-      if (e instanceof MeshMorphError) {
-        send({ type: 'error', id, code: e.code, message: e.message });
-      } else {
-        // A trap inside wasm (abort, unreachable, out of memory) leaves the module unusable:
-        // tell the client to replace this worker.
-        const trapped = e instanceof WebAssembly.RuntimeError || /abort|out of memory/i.test(String(e?.message));
-        send({ type: 'error', id, code: trapped ? 'Crashed' : 'Internal', message: `${op}: ${e?.message || e}`, fatal: trapped });
-      }
+      send(errorMessage(id, failure(op, e)));
     } finally {
       ctx.progress = () => true;
     }
@@ -87,17 +80,26 @@ export function createWorkerRuntime({ loadModule, opFiles, post }) {
       case 'run': return run(message);
       case 'cancel': cancelledIds.add(message.id); return undefined;
       default:
-        send({ type: 'error', id: message?.id ?? null, code: 'InvalidArgument', message: `unknown message type '${message?.type}'` });
+        send(errorMessage(message?.id ?? null, new MeshMorphError('InvalidArgument', `unknown message type '${message?.type}'`)));
         return undefined;
     }
   };
+}
+
+// What an op's exception means for the client: a MeshMorphError as it is (a data error the
+// op reported); a trap inside wasm (abort, unreachable, out of memory) leaves the module
+// unusable, so it is fatal and the client replaces this worker; anything else is a bug.
+function failure(op, e) {
+  if (e instanceof MeshMorphError) return e;
+  const trapped = e instanceof WebAssembly.RuntimeError || /abort|out of memory/i.test(String(e?.message));
+  return new MeshMorphError(trapped ? 'Crashed' : 'Internal', `${op}: ${e?.message || e}`, { fatal: trapped });
 }
 
 function collectOps(opFiles) {
   const ops = new Map();
   for (const [file, exports] of Object.entries(opFiles)) {
     for (const [name, fn] of Object.entries(exports.ops || {})) {
-      if (ops.has(name)) throw new Error(`op '${name}' is defined in ${ops.get(name).file} and ${file}`);
+      if (ops.has(name)) throw new MeshMorphError('Internal', `op '${name}' is defined in ${ops.get(name).file} and ${file}`);
       ops.set(name, { fn, file });
     }
   }

@@ -1,10 +1,12 @@
 // The three.js view: renderer, camera with orbit controls, lights, one mesh whose
-// BufferGeometry is swapped by arrays.js. Renders on demand (controls change, geometry
-// change, resize) instead of every frame, so an idle page costs nothing and headless tests
-// on a software GPU stay fast.
+// BufferGeometry is swapped by lib/arrays.js, vertex picking on it (picking.js) and overlay
+// markers (marker.js). Renders on demand (controls change, geometry change, resize) instead
+// of every frame, so an idle page costs nothing and headless tests on a software GPU stay fast.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { applyArrays } from './arrays.js';
+import { applyArrays } from '../lib/arrays.js';
+import { VertexMarker } from './marker.js';
+import { VertexPicker, ndcFromClient } from './picking.js';
 
 export const backgroundColor = 0x1d2230;
 const surfaceColor = 0xc9cfd8;
@@ -40,6 +42,11 @@ export class Viewer {
     this.wire = new THREE.Mesh(this.geometry, this.wireMaterial);
     this.wire.visible = false;
     this.scene.add(this.mesh, this.wire);
+    this.overlays = new THREE.Group(); // markers and other helpers drawn over the mesh
+    this.scene.add(this.overlays);
+    this.markers = [];
+    this.picker = new VertexPicker();
+    this.toWelded = null; // raw → welded vertex map of the shown mesh, when known
 
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.enableDamping = false;
@@ -71,11 +78,13 @@ export class Viewer {
     });
   }
 
-  // A new mesh: positions/normals/indices from the worker's load result. Replaces the
-  // geometry (sizes differ) and frames the camera on it.
+  // A new mesh: positions/normals/indices (+ toWelded, the raw → welded vertex map) from the
+  // worker's load result. Replaces the geometry (sizes differ), frames the camera on it,
+  // hides the markers and points picking at the new geometry (its BVH is rebuilt on the next
+  // pick).
   // `open`: the surface has boundaries, so its inside can be seen and back faces are drawn
   // (on closed meshes they only add dark speckles along silhouettes).
-  setMesh({ positions, normals, indices }, { open = true } = {}) {
+  setMesh({ positions, normals, indices, toWelded = null }, { open = true } = {}) {
     this.material.side = open ? THREE.DoubleSide : THREE.FrontSide;
     this.material.needsUpdate = true;
     const geometry = new THREE.BufferGeometry();
@@ -85,8 +94,39 @@ export class Viewer {
     this.wire.geometry = geometry;
     this.geometry.dispose();
     this.geometry = geometry;
+    this.toWelded = toWelded;
+    this.picker.setTarget(this.mesh, { toWelded });
+    const radius = geometry.boundingSphere?.radius || 1;
+    for (const marker of this.markers) {
+      marker.setSize(radius * 0.012);
+      marker.hide();
+    }
     this.setColors(null);
     this.frame();
+    // Build the picking BVH when the page is idle (~0.1–0.3 s for 50k vertices), not on the
+    // first hover; a pick before that builds it itself.
+    const schedule = window.requestIdleCallback || ((fn) => setTimeout(fn, 0));
+    schedule(() => {
+      if (this.geometry === geometry) this.picker.ensureBvh();
+    });
+  }
+
+  // The vertex under a pointer position (clientX/clientY, as in mouse events) or null; see
+  // picking.js for the result.
+  pickAt(clientX, clientY) {
+    if (!this.geometry.getAttribute('position')) return null;
+    const [x, y] = ndcFromClient(clientX, clientY, this.renderer.domElement.getBoundingClientRect());
+    this.camera.updateMatrixWorld();
+    return this.picker.pickNdc(x, y, this.camera);
+  }
+
+  // A marker (small sphere) for a vertex, sized to the current mesh; hidden until shown.
+  createMarker({ color }) {
+    const marker = new VertexMarker({ color, onChange: () => this.requestRender() });
+    marker.setSize((this.geometry.boundingSphere?.radius || 1) * 0.012);
+    this.markers.push(marker);
+    this.overlays.add(marker.object);
+    return marker;
   }
 
   // Per-vertex colours (#R·3 in 0..1, raw layout) or null for the plain surface.

@@ -1,13 +1,13 @@
 // Worker ops of the edit module (bindings in wasm/bind_edit.cpp, core in core/edit): an
 // interactive editing session on the mesh in a slot — create once per (ROI, handles, fixed)
 // set, drag many times (fast preview), finalize when the user lets go, dispose when done.
-// Registered by web/src/worker.js like every web/src/ops/*.js file; see ops/mesh.js for the op
-// signature `(ctx, options, buffers) => {info, buffers}` and ctx.state.
+// Listed in worker/ops/index.js like every ops file; see ops/mesh.js for the op signature
+// `(ctx, options, buffers) => {info, buffers}` and ctx.state.
 //
 // Positions come back twice: `positions` on the welded mesh (#W·3, what core computed, what the
 // export op takes) and `rawPositions` in the loaded file's vertex layout (#R·3, through the
 // asset's toWelded map) for swapping into the three.js BufferGeometry directly.
-import { MeshMorphError, unwrap } from '../errors.js';
+import { MeshMorphError, unwrap } from '../../lib/errors.js';
 import { defaultSlot, meshInSlot } from './mesh.js';
 
 function editSessions(ctx) {

@@ -1,0 +1,137 @@
+// The page's shell: hosts the panels (ui/panels/) under a job switcher bar, and owns what all
+// jobs share: the status line, the progress overlay with Cancel, the error banner, the busy
+// state and the one way to run a worker op (runOp). Panels get the shell as their `app`:
+//   app.state     what the page shows (window.__meshmorph.state; each panel adds its fields)
+//   app.client    the worker client (lib/client.js); app.viewer the three.js view (view/)
+//   app.params    the page's URL parameters
+//   app.runOp(label, op, options, buffers, extra) → result or null (the error is shown)
+//   app.on(event, fn) / app.emit(event, detail)   events between panels: 'ready' (the worker
+//                 is up), 'mesh' (a mesh was loaded; detail = app.state.mesh), 'job' (switched)
+//   app.showError(e), app.clearError(), app.setStatus(text)
+// Controls marked `data-idle` in a panel's markup are disabled while an op runs or the
+// worker is not ready.
+import { toMeshMorphError } from '../lib/errors.js';
+import { byId } from './dom.js';
+import { ErrorBanner } from './error-banner.js';
+import { ProgressView } from './progress.js';
+import { JobSwitcher } from './switcher.js';
+
+export class Shell {
+  constructor({ client, viewer, params }) {
+    this.client = client;
+    this.viewer = viewer;
+    this.params = params;
+    this.state = {
+      ready: false,
+      busy: null,   // {id, label} of the running request
+      error: null,  // {code, message} of the last error shown
+    };
+    this.events = new EventTarget();
+    this.panels = []; // {panel, element, job} in registration order
+    this.host = byId('panels');
+    this.statusLine = byId('status');
+    this.progress = new ProgressView(() => {
+      if (this.state.busy) client.cancel(this.state.busy.id);
+    });
+    this.errors = new ErrorBanner();
+    this.switcher = new JobSwitcher(byId('jobs'), (job) => this.showJob(job));
+  }
+
+  // panel: {id, title, job?, create(app) → Element}. `job` is the switcher entry the panel
+  // appears under (default: its own id); the entry's title is the title of the panel whose id
+  // is the job's.
+  register(panel) {
+    if (this.panels.some((p) => p.panel.id === panel.id)) throw new Error(`panel '${panel.id}' is registered twice`);
+    const job = panel.job || panel.id;
+    const element = panel.create(this);
+    element.dataset.panel = panel.id;
+    this.host.append(element);
+    this.panels.push({ panel, element, job });
+    this.switcher.add(job, this.jobTitle(job));
+    element.hidden = job !== this.switcher.selected;
+    this.updateControls();
+  }
+
+  jobTitle(job) {
+    return this.panels.find((p) => p.panel.id === job)?.panel.title || job;
+  }
+
+  showJob(job) {
+    for (const p of this.panels) p.element.hidden = p.job !== job;
+    this.emit('job', job);
+  }
+
+  on(name, fn) {
+    this.events.addEventListener(name, (e) => fn(e.detail));
+  }
+
+  emit(name, detail) {
+    this.events.dispatchEvent(new CustomEvent(name, { detail }));
+  }
+
+  setStatus(text) {
+    this.statusLine.textContent = text;
+  }
+
+  showError(e) {
+    const error = toMeshMorphError(e, 'Error');
+    this.state.error = { code: error.code, message: error.message };
+    this.errors.show(error);
+    console.error(`[meshmorph] ${error.code}: ${error.message}`);
+  }
+
+  clearError() {
+    this.errors.hide();
+  }
+
+  setBusy(busy) {
+    this.state.busy = busy;
+    if (busy) this.progress.show(busy.label);
+    else this.progress.hide();
+    this.updateControls();
+  }
+
+  updateControls() {
+    const idle = this.state.ready && !this.state.busy;
+    for (const control of this.host.querySelectorAll('[data-idle]')) {
+      control.disabled = !idle;
+      control.closest('label.button')?.classList.toggle('disabled', !idle);
+    }
+  }
+
+  // Runs one worker op with the progress bar and Cancel button; errors are shown, not thrown
+  // (returns null), so every caller leaves the page usable.
+  async runOp(label, op, options, buffers, extra = {}) {
+    this.clearError();
+    const { id, promise } = this.client.run(op, options, buffers, {
+      ...extra,
+      onProgress: (stage, fraction) => this.progress.update(label, stage, fraction),
+    });
+    this.setBusy({ id, label });
+    try {
+      return await promise;
+    } catch (e) {
+      this.showError(e);
+      return null;
+    } finally {
+      this.setBusy(null);
+    }
+  }
+
+  // Waits for the worker, then tells the panels ('ready').
+  start() {
+    this.setBusy(null);
+    this.client.ready.then(
+      () => {
+        this.state.ready = true;
+        this.setBusy(null);
+        this.setStatus(`ready · cancel: ${this.client.cancelMode}`);
+        this.emit('ready');
+      },
+      (e) => {
+        this.setStatus('the geometry module failed to start');
+        this.showError(e);
+      },
+    );
+  }
+}
