@@ -62,3 +62,14 @@ test('the wasm bindings reject options the schema does not know, naming them', a
   assert.equal(range.ok, false);
   assert.match(range.message, /cage_vertices/);
 });
+
+test('the worker op optionSchema returns the schema the bindings use', async () => {
+  const { ops } = await import('../../web/src/worker/ops/mesh.js');
+  const { makeContext } = await import('./wasm_module.mjs');
+  const ctx = await makeContext();
+  const r = ops.optionSchema(ctx, { job: 'transfer' });
+  const names = r.info.options.map((o) => o.name);
+  assert.ok(names.includes('cage_vertices') && names.includes('lambda1'), names.join(','));
+  assert.equal(r.info.options.find((o) => o.name === 'cage_vertices').default, 450);
+  assert.throws(() => ops.optionSchema(ctx, { job: 'nope' }), /no job named/);
+});

@@ -8,6 +8,7 @@
 // Page-level codes: Cancelled (user pressed Cancel; same name as the core's), Aborted (a queued
 // request died with a restarted worker), Crashed (the wasm module trapped; the worker is
 // replaced), InitFailed (the module could not start), Internal (a bug: stray C++ exception),
+// OutOfMemory (the wasm heap is exhausted; both come from the bindings' guard, wasm/guard.h),
 // Unsupported / IoError (the page could not read a file it was given).
 export class MeshMorphError extends Error {
   // fatal: the worker that produced it cannot be used any more (a wasm trap).

@@ -7,8 +7,9 @@
 export interface Failure {
   ok: false;
   /** StatusCode name (core/common/status.h): InvalidArgument, InvalidMesh, IoError, ParseError,
-   *  Unsupported, FactorizationFailed, NotConverged, NumericalError, Cancelled; or Internal
-   *  (a C++ exception escaped: a bug or out of memory). */
+   *  Unsupported, FactorizationFailed, NotConverged, NumericalError, Cancelled; or, from the one
+   *  guard every binding goes through (wasm/guard.h), Internal (a C++ exception escaped: a bug)
+   *  and OutOfMemory (the 4 GB heap is exhausted). */
   code: string;
   /** A sentence a user can act on, e.g. "mesh has 12 non-manifold edges, first at vertices 10-11". */
   message: string;
@@ -50,7 +51,22 @@ export interface SpectralBasisOptions {
 
 /** The Emscripten module (meshmorph_web.mjs in the worker, meshmorph_node.cjs in tests).
  *  Embind checks argument counts: pass `undefined` for an optional argument, never omit it. */
+/** One option of a job, from its schema (app/option_schema.h): the same description gives the
+ *  CLI its flags and --help, the bindings their option parsing, and the page its options panels. */
+export interface OptionDescription {
+  name: string;                 // key in the options object of the job's binding / op
+  kind: 'integer' | 'number' | 'boolean' | 'choice' | 'text';
+  default: number | boolean | string;
+  min?: number; max?: number;   // inclusive (integer, number)
+  choices?: string[];           // choice
+  flag: string;                 // the CLI flag, e.g. "--cage-vertices"
+  help: string;                 // one line
+}
+export interface OptionSchema { job: 'edit' | 'transfer' | 'retarget'; summary: string; options: OptionDescription[] }
+
 export interface MeshMorphModule {
+  /** The options schema of a job (`meshmorph options --json` prints the same). */
+  optionSchema(job: string): Result<{ schema: OptionSchema }>;
   /** Loads a file by its name's extension (.glb .gltf .obj .off .ply). `files` resolves a
    *  .gltf's external URIs (exact key, then last path segment). The asset stays registered
    *  until disposeAsset. */

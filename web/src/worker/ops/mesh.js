@@ -9,7 +9,8 @@
 //                a Map slot → {asset, name, format, weldedPositions, weldedIndices, toWelded}
 //   ctx.progress (stage, fraction) => boolean; false means "cancel" and is handed to the
 //                core's Progress sink, which stops with code Cancelled
-// Options use the C++ field names (a missing field means the core's default). Returned
+// Options use the names of the job's options schema (optionSchema below; a missing field means
+// the core's default, an unknown one is an error). Returned
 // typed arrays are transferred to the caller.
 import { MeshMorphError, unwrap } from '../../lib/errors.js';
 
@@ -118,6 +119,13 @@ export const ops = {
         milliseconds: Date.now() - started,
       },
     };
+  },
+
+  // The options schema of a job (app/option_schema.h; the CLI's flags and --help come from it):
+  // options {job: 'edit' | 'transfer' | 'retarget'} → info {job, summary, options: [{name, kind,
+  // default, min?, max?, choices?, flag, help}]}. Options panels are generated from it.
+  optionSchema(ctx, options = {}) {
+    return { buffers: {}, info: unwrap(ctx.module.optionSchema(String(options.job ?? ''))).schema };
   },
 
   // Writes the asset in `slot` (default GLB) keeping everything the loaded document had.
