@@ -54,11 +54,11 @@ test('the wasm bindings reject options the schema does not know, naming them', a
   const module = await loadModule();
   const tri = new Float64Array([0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1]);
   const idx = new Uint32Array([0, 1, 2, 0, 3, 1, 0, 2, 3, 1, 3, 2]);
-  const r = module.poseTransfer(tri, idx, tri, idx, new Int32Array(0), { lambda_one: 0.1 }, undefined);
+  const r = module.poseTransfer(tri, idx, tri, idx, new Int32Array(0), { lambda_one: 0.1 }, undefined, undefined, undefined);
   assert.equal(r.ok, false);
   assert.equal(r.code, 'InvalidArgument');
   assert.match(r.message, /lambda_one/);
-  const range = module.poseTransfer(tri, idx, tri, idx, new Int32Array(0), { cage_vertices: 2 }, undefined);
+  const range = module.poseTransfer(tri, idx, tri, idx, new Int32Array(0), { cage_vertices: 2 }, undefined, undefined, undefined);
   assert.equal(range.ok, false);
   assert.match(range.message, /cage_vertices/);
 });

@@ -18,13 +18,14 @@ function session(ctx, id) {
 }
 
 export const ops = {
-  // options: {sourceName, targetName, targetJointsJson?, jointMapJson?, clip, fps, first_frame,
-  //           last_frame, method, num_singularities, offset, w_*, bone_iterations, surface_descriptors}
+  // options: {sourceName, targetName, targetJointsJson?, jointMapJson?, ...any option of the
+  //           retarget job's schema (optionSchema {job: 'retarget'}: clip, fps, first_frame, method, ...)}
   // buffers: {source: bytes, target: bytes}
   retargetPrepare(ctx, options = {}, buffers = {}) {
-    const r = unwrap(ctx.module.retargetPrepare(toBytes(buffers.source), options.sourceName || 'source.glb',
-      toBytes(buffers.target), options.targetName || 'target.glb', options.targetJointsJson || '',
-      options.jointMapJson || '', options, ctx.progress));
+    const { sourceName, targetName, targetJointsJson, jointMapJson, ...jobOptions } = options;
+    const r = unwrap(ctx.module.retargetPrepare(toBytes(buffers.source), sourceName || 'source.glb',
+      toBytes(buffers.target), targetName || 'target.glb', targetJointsJson || '',
+      jointMapJson || '', jobOptions, ctx.progress));
     if (!ctx.state.retarget) ctx.state.retarget = new Map();
     ctx.state.retarget.set(r.session, { frames: r.frames });
     return {
