@@ -7,6 +7,7 @@
 
 #include "app/edit_job.h"
 #include "edit/selection.h"
+#include "io/json_text.h"
 #include "mesh/mesh.h"
 
 namespace mm {
@@ -232,6 +233,10 @@ using namespace edit_spec_detail;
 
 EditSpecResult parse_edit_spec(const std::string& json_text, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   EditSpecResult out;
+  if (Status d = io::check_json_depth(json_text, "edit spec"); !d.ok()) {
+    out.status = d;
+    return out;
+  }
   EditSpecParser p{V, F, bounding_box_diagonal(V), {}};
   const EditSpecJson j = EditSpecJson::parse(json_text, nullptr, /*allow_exceptions=*/false);
   if (j.is_discarded()) {
@@ -336,6 +341,10 @@ HandleTransformsResult parse_handle_transforms(const std::string& json_text, con
                                                const EditRegion& region) {
   HandleTransformsResult out;
   Eigen::MatrixXi noF(0, 3);
+  if (Status d = io::check_json_depth(json_text, "handle transforms"); !d.ok()) {
+    out.status = d;
+    return out;
+  }
   EditSpecParser p{V, noF, bounding_box_diagonal(V), {}};
   const EditSpecJson j = EditSpecJson::parse(json_text, nullptr, false);
   if (j.is_discarded() || !j.is_array()) {

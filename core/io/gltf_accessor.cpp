@@ -76,11 +76,17 @@ static const uint8_t* accessor_view_data(const tinygltf::Model& model, int bv, u
   if (view.buffer < 0 || view.buffer >= static_cast<int>(model.buffers.size()))
     return fail("bufferView " + std::to_string(bv) + " refers to missing buffer " + std::to_string(view.buffer));
   const std::vector<unsigned char>& data = model.buffers[view.buffer].data;
-  if (static_cast<uint64_t>(view.byteOffset) + view.byteLength > data.size())
+  const uint64_t view_offset = view.byteOffset, view_length = view.byteLength;
+  if (view_offset > data.size() || view_length > data.size() - view_offset)
     return fail("bufferView " + std::to_string(bv) + " (offset " + std::to_string(view.byteOffset) + ", length " +
                 std::to_string(view.byteLength) + ") lies outside its buffer of " + std::to_string(data.size()) +
                 " bytes");
-  if (count > 0 && offset + (count - 1) * stride + elem_size > view.byteLength)
+  // offset + (count − 1)·stride + elem_size ≤ byteLength, without wrapping around (offsets near
+  // 2^64 or huge counts must fail here, not read out of bounds).
+  const bool overruns =
+      count > 0 && (offset > view_length || elem_size > view_length - offset ||
+                    (count - 1) > (view_length - offset - elem_size) / (stride > 0 ? stride : 1));
+  if (overruns)
     return fail(std::to_string(count) + " elements of " + std::to_string(elem_size) + " bytes (stride " +
                 std::to_string(stride) + ", offset " + std::to_string(offset) + ") overrun bufferView " +
                 std::to_string(bv) + " of " + std::to_string(view.byteLength) + " bytes");
@@ -148,6 +154,70 @@ Status read_gltf_accessor(const tinygltf::Model& model, int index, Eigen::Matrix
         (*out)(static_cast<Eigen::Index>(target), c) = accessor_component(pv + k * elem + c * cs, a.componentType, a.normalized);
     }
   }
+  return Status::success();
+}
+
+bool gltf_is_triangle_mode(int mode) {
+  return mode == -1 || mode == TINYGLTF_MODE_TRIANGLES || mode == TINYGLTF_MODE_TRIANGLE_STRIP ||
+         mode == TINYGLTF_MODE_TRIANGLE_FAN;
+}
+
+Status read_gltf_triangles(const tinygltf::Model& model, const tinygltf::Primitive& prim, const std::string& label,
+                           GltfTriangles* out) {
+  auto fail = [&](const std::string& why) { return Status::error(StatusCode::ParseError, label + " " + why); };
+  const auto pos_it = prim.attributes.find("POSITION");
+  if (pos_it == prim.attributes.end()) return fail("has no POSITION attribute");
+  Status s = read_gltf_accessor(model, pos_it->second, &out->P);
+  if (!s.ok()) return Status::error(s.code, label + " POSITION: " + s.message);
+  if (out->P.cols() != 3) return fail("POSITION is not VEC3");
+  const int ct = model.accessors[pos_it->second].componentType;
+  if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT) {
+    bool quantized = false;
+    for (const std::string& e : model.extensionsUsed) quantized |= e == "KHR_mesh_quantization";
+    const bool quantizable = ct == TINYGLTF_COMPONENT_TYPE_BYTE || ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                             ct == TINYGLTF_COMPONENT_TYPE_SHORT || ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+    if (!quantized || !quantizable)
+      return fail("POSITION has componentType " + std::to_string(ct) +
+                  (quantizable ? " without the KHR_mesh_quantization extension" : "") + "; glTF requires FLOAT (5126)");
+  }
+  const int64_t nv = out->P.rows();
+  std::vector<int64_t> I;
+  if (prim.indices >= 0) {
+    Eigen::MatrixXd idx;
+    s = read_gltf_accessor(model, prim.indices, &idx);
+    if (!s.ok()) return Status::error(s.code, label + " indices: " + s.message);
+    const int ict = model.accessors[prim.indices].componentType;
+    if (idx.cols() != 1 || (ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                            ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+      return fail("indices must be unsigned integer scalars");
+    I.resize(static_cast<size_t>(idx.rows()));
+    for (Eigen::Index k = 0; k < idx.rows(); ++k) {
+      if (idx(k, 0) >= static_cast<double>(nv))
+        return fail("index " + std::to_string(k) + " is " + std::to_string(static_cast<long long>(idx(k, 0))) +
+                    " but POSITION has only " + std::to_string(nv) + " vertices");
+      I[static_cast<size_t>(k)] = static_cast<int64_t>(idx(k, 0));
+    }
+  } else {
+    I.resize(static_cast<size_t>(nv));
+    for (int64_t k = 0; k < nv; ++k) I[static_cast<size_t>(k)] = k;
+  }
+  const int64_t n = static_cast<int64_t>(I.size());
+  std::vector<int64_t> T;
+  if (prim.mode == TINYGLTF_MODE_TRIANGLE_STRIP || prim.mode == TINYGLTF_MODE_TRIANGLE_FAN) {
+    if (n > 0 && n < 3) return fail("has " + std::to_string(n) + " vertices, too few for a triangle strip or fan");
+    for (int64_t i = 0; i + 2 < n; ++i) {
+      if (prim.mode == TINYGLTF_MODE_TRIANGLE_STRIP)
+        T.insert(T.end(), {I[i], I[i + 1 + i % 2], I[i + 2 - i % 2]});
+      else
+        T.insert(T.end(), {I[i + 1], I[i + 2], I[0]});
+    }
+  } else {
+    if (n % 3 != 0) return fail("has " + std::to_string(n) + " indices, not a multiple of 3");
+    T = std::move(I);
+  }
+  out->F.resize(static_cast<Eigen::Index>(T.size() / 3), 3);
+  for (Eigen::Index f = 0; f < out->F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) out->F(f, k) = static_cast<int>(T[static_cast<size_t>(3 * f + k)]);
   return Status::success();
 }
 

@@ -22,4 +22,19 @@ int gltf_component_size(int component_type);
 // An accessor without a bufferView reads as zeros (plus its sparse values).
 Status read_gltf_accessor(const tinygltf::Model& model, int index, Eigen::MatrixXd* out);
 
+// TRIANGLES (4, or -1 = default), TRIANGLE_STRIP (5) and TRIANGLE_FAN (6) make triangles.
+bool gltf_is_triangle_mode(int mode);
+
+// The triangles of a triangle primitive: POSITION read and checked (VEC3; FLOAT, or with
+// KHR_mesh_quantization also (normalized) BYTE/UNSIGNED_BYTE/SHORT/UNSIGNED_SHORT), indices
+// unsigned-integer scalars in range, strips and fans unrolled into triangles (glTF 2.0 §3.7.2.1:
+// strip p_i = {v_i, v_(i+1+i%2), v_(i+2−i%2)}, fan p_i = {v_(i+1), v_(i+2), v_0}). `label` prefixes
+// every error ("mesh 0 ('body') primitive 1").
+struct GltfTriangles {
+  Eigen::MatrixXd P;  // #v by 3 POSITION (mesh space)
+  Eigen::MatrixXi F;  // #f by 3 indices into P
+};
+Status read_gltf_triangles(const tinygltf::Model& model, const tinygltf::Primitive& prim, const std::string& label,
+                           GltfTriangles* out);
+
 }  // namespace mm::io

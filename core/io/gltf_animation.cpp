@@ -144,7 +144,7 @@ CharacterResult animated_character(const Asset& asset, const CharacterOptions& o
     const tinygltf::Mesh& mesh = m.meshes[node.mesh];
     for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
       const tinygltf::Primitive& prim = mesh.primitives[pi];
-      if (prim.mode != -1 && prim.mode != TINYGLTF_MODE_TRIANGLES) continue;
+      if (!gltf_is_triangle_mode(prim.mode)) continue;
       auto pos = prim.attributes.find("POSITION");
       if (pos == prim.attributes.end()) continue;
       Candidate cd;
@@ -152,27 +152,15 @@ CharacterResult animated_character(const Asset& asset, const CharacterOptions& o
       p.node = ni;
       p.mesh = node.mesh;
       p.primitive = static_cast<int>(pi);
-      Status st = read_gltf_accessor(m, pos->second, &p.local);
-      if (!st.ok() || p.local.cols() != 3) {
-        r.status = Status::error(StatusCode::ParseError, "mesh " + std::to_string(node.mesh) + ": bad POSITION");
+      GltfTriangles tris;
+      const std::string label = "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(pi);
+      if (Status st = read_gltf_triangles(m, prim, label, &tris); !st.ok()) {
+        r.status = st;
         return r;
       }
+      p.local = std::move(tris.P);
       p.num_vertices = static_cast<int>(p.local.rows());
-      if (prim.indices >= 0) {
-        Eigen::MatrixXd idx;
-        st = read_gltf_accessor(m, prim.indices, &idx);
-        if (!st.ok() || idx.cols() != 1 || idx.rows() % 3 != 0) {
-          r.status = Status::error(StatusCode::ParseError, "mesh " + std::to_string(node.mesh) + ": bad indices");
-          return r;
-        }
-        cd.F.resize(idx.rows() / 3, 3);
-        for (int f = 0; f < cd.F.rows(); ++f)
-          for (int k = 0; k < 3; ++k) cd.F(f, k) = static_cast<int>(idx(3 * f + k, 0));
-      } else {
-        cd.F.resize(p.num_vertices / 3, 3);
-        for (int f = 0; f < cd.F.rows(); ++f)
-          for (int k = 0; k < 3; ++k) cd.F(f, k) = 3 * f + k;
-      }
+      cd.F = std::move(tris.F);
       if (cd.F.size() > 0 && (cd.F.minCoeff() < 0 || cd.F.maxCoeff() >= p.num_vertices)) {
         r.status = Status::error(StatusCode::ParseError, "mesh " + std::to_string(node.mesh) + ": index out of range");
         return r;

@@ -1,5 +1,7 @@
 #include "io/gltf_load.h"
 
+#include <cmath>
+
 #include <cstring>
 #include <map>
 #include <sstream>
@@ -10,6 +12,7 @@
 #include "io/gltf_accessor.h"
 #include "io/gltf_document.h"
 #include "io/gltf_uri.h"
+#include "io/json_text.h"
 
 namespace mm::io {
 
@@ -113,12 +116,20 @@ static Status gltf_glb_json(const std::vector<uint8_t>& b, const std::string& na
   return Status::success();
 }
 
-static uint64_t gltf_json_uint(const nlohmann::json& o, const char* key, uint64_t fallback) {
+// Non-negative integer field `key` of `o`, or `fallback` when absent. A present value that is
+// negative, fractional, too large or not a number sets *bad (the caller names the field).
+static uint64_t gltf_json_uint(const nlohmann::json& o, const char* key, uint64_t fallback, bool* bad) {
   const auto it = o.find(key);
-  if (it == o.end() || !it->is_number_unsigned()) return it != o.end() && it->is_number_integer() && it->get<int64_t>() >= 0
-                                                              ? static_cast<uint64_t>(it->get<int64_t>())
-                                                              : fallback;
-  return it->get<uint64_t>();
+  if (it == o.end()) return fallback;
+  if (it->is_number_unsigned()) return it->get<uint64_t>();
+  if (it->is_number_integer() && it->get<int64_t>() >= 0) return static_cast<uint64_t>(it->get<int64_t>());
+  *bad = true;
+  return fallback;
+}
+
+// offset + length ≤ size without wrapping around.
+static bool gltf_range_fits(uint64_t offset, uint64_t length, uint64_t size) {
+  return offset <= size && length <= size - offset;
 }
 
 // What tinygltf does not check before touching memory (image bufferViews are read during
@@ -140,7 +151,9 @@ static Status gltf_precheck(const nlohmann::json& j, bool binary, uint64_t bin_s
     for (size_t i = 0; i < buffers->size(); ++i) {
       const nlohmann::json& b = (*buffers)[i];
       if (!b.is_object()) return fail(StatusCode::ParseError, "buffer " + std::to_string(i) + " is not an object");
-      buffer_len.push_back(gltf_json_uint(b, "byteLength", 0));
+      bool bad = false;
+      buffer_len.push_back(gltf_json_uint(b, "byteLength", 0, &bad));
+      if (bad) return fail(StatusCode::ParseError, "buffer " + std::to_string(i) + " has an invalid byteLength (not a non-negative integer)");
       const auto uri_it = b.find("uri");
       if (uri_it == b.end() || !uri_it->is_string()) {
         if (!(binary && i == 0))
@@ -157,10 +170,10 @@ static Status gltf_precheck(const nlohmann::json& j, bool binary, uint64_t bin_s
       if (!s.ok()) return s;
       std::vector<uint8_t> bytes;
       if (!resolver || !resolver(decoded, &bytes))
-        return fail(StatusCode::IoError, "buffer " + std::to_string(i) + " refers to the missing file '" + decoded +
+        return fail(StatusCode::IoError, "buffer " + std::to_string(i) + " refers to the missing file '" + quote_input(decoded) +
                                              "' (it must be next to the .gltf file)");
       if (bytes.size() < buffer_len.back())
-        return fail(StatusCode::ParseError, "'" + decoded + "' has " + std::to_string(bytes.size()) +
+        return fail(StatusCode::ParseError, "'" + quote_input(decoded) + "' has " + std::to_string(bytes.size()) +
                                                 " bytes but buffer " + std::to_string(i) + " declares " +
                                                 std::to_string(buffer_len.back()));
       // The glTF spec allows a file longer than byteLength (padding); tinygltf wants exact.
@@ -174,15 +187,80 @@ static Status gltf_precheck(const nlohmann::json& j, bool binary, uint64_t bin_s
     for (size_t i = 0; i < bvs->size(); ++i) {
       const nlohmann::json& v = (*bvs)[i];
       if (!v.is_object()) return fail(StatusCode::ParseError, "bufferView " + std::to_string(i) + " is not an object");
-      const uint64_t buf = gltf_json_uint(v, "buffer", UINT64_MAX);
-      const uint64_t end = gltf_json_uint(v, "byteOffset", 0) + gltf_json_uint(v, "byteLength", 0);
+      bool bad = false;
+      const uint64_t buf = gltf_json_uint(v, "buffer", UINT64_MAX, &bad);
+      const uint64_t offset = gltf_json_uint(v, "byteOffset", 0, &bad), length = gltf_json_uint(v, "byteLength", 0, &bad);
+      const uint64_t stride = gltf_json_uint(v, "byteStride", 0, &bad);
+      if (bad)
+        return fail(StatusCode::ParseError, "bufferView " + std::to_string(i) +
+                                                " has a buffer, byteOffset, byteLength or byteStride that is not a non-negative integer");
       if (buf >= buffer_len.size())
         return fail(StatusCode::ParseError, "bufferView " + std::to_string(i) + " refers to a missing buffer");
-      if (end > buffer_len[buf])
-        return fail(StatusCode::ParseError, "bufferView " + std::to_string(i) + " ends at byte " + std::to_string(end) +
-                                                " beyond buffer " + std::to_string(buf) + " (" +
-                                                std::to_string(buffer_len[buf]) + " bytes)");
-      views.emplace_back(buf, end);
+      if (!gltf_range_fits(offset, length, buffer_len[buf]))
+        return fail(StatusCode::ParseError, "bufferView " + std::to_string(i) + " (offset " + std::to_string(offset) +
+                                                ", length " + std::to_string(length) + ") lies outside buffer " +
+                                                std::to_string(buf) + " (" + std::to_string(buffer_len[buf]) + " bytes)");
+      if (stride != 0 && (stride < 4 || stride > 252))
+        return fail(StatusCode::ParseError, "bufferView " + std::to_string(i) + " has byteStride " + std::to_string(stride) +
+                                                " (glTF allows 4 to 252)");
+      views.emplace_back(buf, offset + length);
+    }
+  }
+  const auto accessors = j.find("accessors");
+  if (accessors != j.end() && accessors->is_array()) {
+    for (size_t i = 0; i < accessors->size(); ++i) {
+      const nlohmann::json& a = (*accessors)[i];
+      if (!a.is_object()) return fail(StatusCode::ParseError, "accessor " + std::to_string(i) + " is not an object");
+      bool bad = false;
+      const uint64_t view = gltf_json_uint(a, "bufferView", UINT64_MAX, &bad);
+      gltf_json_uint(a, "byteOffset", 0, &bad);
+      gltf_json_uint(a, "count", 0, &bad);
+      if (bad)
+        return fail(StatusCode::ParseError, "accessor " + std::to_string(i) +
+                                                " has a bufferView, byteOffset or count that is not a non-negative integer");
+      if (a.contains("bufferView") && view >= views.size())
+        return fail(StatusCode::ParseError, "accessor " + std::to_string(i) + " refers to a missing bufferView");
+    }
+  }
+  // Skins and animations reference nodes and samplers by index; tinygltf does not check them.
+  const auto nodes = j.find("nodes");
+  const uint64_t num_nodes = nodes != j.end() && nodes->is_array() ? nodes->size() : 0;
+  const auto skins = j.find("skins");
+  if (skins != j.end() && skins->is_array()) {
+    for (size_t i = 0; i < skins->size(); ++i) {
+      const nlohmann::json& sk = (*skins)[i];
+      const auto jt = sk.is_object() ? sk.find("joints") : sk.end();
+      if (!sk.is_object() || jt == sk.end() || !jt->is_array())
+        return fail(StatusCode::ParseError, "skin " + std::to_string(i) + " has no joints array");
+      for (size_t k = 0; k < jt->size(); ++k) {
+        const nlohmann::json& n = (*jt)[k];
+        if (!n.is_number_integer() || n.get<int64_t>() < 0 || static_cast<uint64_t>(n.get<int64_t>()) >= num_nodes)
+          return fail(StatusCode::ParseError, "skin " + std::to_string(i) + " joint " + std::to_string(k) +
+                                                  " is not one of the " + std::to_string(num_nodes) + " nodes");
+      }
+    }
+  }
+  const auto animations = j.find("animations");
+  if (animations != j.end() && animations->is_array()) {
+    for (size_t i = 0; i < animations->size(); ++i) {
+      const nlohmann::json& an = (*animations)[i];
+      if (!an.is_object()) return fail(StatusCode::ParseError, "animation " + std::to_string(i) + " is not an object");
+      const auto samplers = an.find("samplers");
+      const uint64_t num_samplers = samplers != an.end() && samplers->is_array() ? samplers->size() : 0;
+      const auto channels = an.find("channels");
+      if (channels == an.end() || !channels->is_array()) continue;
+      for (size_t k = 0; k < channels->size(); ++k) {
+        const nlohmann::json& ch = (*channels)[k];
+        bool bad = !ch.is_object();
+        const uint64_t sampler = bad ? 0 : gltf_json_uint(ch, "sampler", UINT64_MAX, &bad);
+        const auto target = bad ? ch.end() : ch.find("target");
+        uint64_t node = 0;
+        if (!bad && target != ch.end() && target->is_object()) node = gltf_json_uint(*target, "node", 0, &bad);
+        if (bad || sampler >= num_samplers || (target != ch.end() && target->is_object() && target->contains("node") &&
+                                               node >= num_nodes))
+          return fail(StatusCode::ParseError, "animation " + std::to_string(i) + " channel " + std::to_string(k) +
+                                                  " refers to a missing sampler or node");
+      }
     }
   }
   const auto images = j.find("images");
@@ -192,7 +270,8 @@ static Status gltf_precheck(const nlohmann::json& j, bool binary, uint64_t bin_s
       const nlohmann::json& im = (*images)[i];
       if (!im.is_object()) return fail(StatusCode::ParseError, "image " + std::to_string(i) + " is not an object");
       if (im.contains("bufferView")) {
-        if (gltf_json_uint(im, "bufferView", UINT64_MAX) >= views.size())
+        bool bad = false;
+        if (gltf_json_uint(im, "bufferView", UINT64_MAX, &bad) >= views.size() || bad)
           return fail(StatusCode::ParseError, "image " + std::to_string(i) + " refers to a missing bufferView");
         continue;
       }
@@ -204,7 +283,7 @@ static Status gltf_precheck(const nlohmann::json& j, bool binary, uint64_t bin_s
       Status s = check_relative_uri(decoded, name + ": image " + std::to_string(i));
       if (!s.ok()) return s;
       if (!resolver || !resolver(decoded, &(*image_files)[i]))
-        warnings->push_back("image " + std::to_string(i) + " ('" + decoded +
+        warnings->push_back("image " + std::to_string(i) + " ('" + quote_input(decoded) +
                             "') was not found; its URI is kept but the image cannot be embedded on export");
     }
   }
@@ -262,6 +341,8 @@ Status load_gltf(const std::vector<uint8_t>& bytes, Format format, const FileRes
     const size_t skip = bytes.size() >= 3 && bytes[0] == 0xEF && bytes[1] == 0xBB && bytes[2] == 0xBF ? 3 : 0;
     json_text.assign(bytes.begin() + skip, bytes.end());
   }
+  // Depth first: tinygltf walks values (extras, extensions) recursively.
+  if (Status d = check_json_depth(json_text, name); !d.ok()) return d;
   auto doc = std::make_shared<GltfDocument>();
   GltfFsContext fs;
   try {
@@ -269,12 +350,12 @@ Status load_gltf(const std::vector<uint8_t>& bytes, Format format, const FileRes
     try {
       j = nlohmann::json::parse(json_text);
     } catch (const nlohmann::json::exception& e) {
-      return Status::error(StatusCode::ParseError, name + ": invalid glTF JSON: " + e.what());
+      return Status::error(StatusCode::ParseError, name + ": invalid glTF JSON: " + cap_message(e.what()));
     }
     Status s = gltf_precheck(j, binary, bin_size, name, resolver, &fs, &doc->image_files, &asset->warnings);
     if (!s.ok()) return s;
   } catch (const std::exception& e) {
-    return Status::error(StatusCode::ParseError, name + ": malformed glTF: " + e.what());
+    return Status::error(StatusCode::ParseError, name + ": malformed glTF: " + cap_message(e.what()));
   }
 
   tinygltf::TinyGLTF loader;
@@ -293,9 +374,20 @@ Status load_gltf(const std::vector<uint8_t>& bytes, Format format, const FileRes
   }
   if (!ok) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
-    return Status::error(StatusCode::ParseError, name + ": invalid glTF: " + (err.empty() ? "unknown error" : err));
+    return Status::error(StatusCode::ParseError, name + ": invalid glTF: " + (err.empty() ? "unknown error" : cap_message(err)));
   }
-  if (!warn.empty()) asset->warnings.push_back(warn);
+  if (!warn.empty()) asset->warnings.push_back(cap_message(warn));
+  for (size_t a = 0; a < model.animations.size(); ++a)
+    for (size_t k = 0; k < model.animations[a].samplers.size(); ++k) {
+      Eigen::MatrixXd t;
+      const std::string where = name + ": animation " + std::to_string(a) + " sampler " + std::to_string(k);
+      if (Status s = read_gltf_accessor(model, model.animations[a].samplers[k].input, &t); !s.ok())
+        return Status::error(s.code, where + " input: " + s.message);
+      for (Eigen::Index i = 0; i < t.rows(); ++i)
+        if (!std::isfinite(t(i, 0)) || (i > 0 && !(t(i, 0) > t(i - 1, 0))))
+          return Status::error(StatusCode::ParseError, where + ": input times must be finite and strictly increasing (key " +
+                                                           std::to_string(i) + ")");
+    }
   for (const std::string& ext : model.extensionsRequired)
     if (ext == "KHR_draco_mesh_compression" || ext == "EXT_meshopt_compression")
       return Status::error(StatusCode::Unsupported, name + ": the file requires the extension " + ext +
@@ -347,46 +439,24 @@ Status load_gltf(const std::vector<uint8_t>& bytes, Format format, const FileRes
       const tinygltf::Primitive& prim = mesh.primitives[pi];
       const std::string label = "mesh " + std::to_string(node.mesh) + (mesh.name.empty() ? "" : " ('" + mesh.name + "')") +
                                 " primitive " + std::to_string(pi);
-      if (prim.mode != TINYGLTF_MODE_TRIANGLES) {
+      if (!gltf_is_triangle_mode(prim.mode)) {
         if (!opt.skip_unsupported_primitives)
           return Status::error(StatusCode::Unsupported,
                                name + ": " + label + " uses mode " + gltf_mode_name(prim.mode) +
-                                   "; only TRIANGLES primitives are supported (load with "
-                                   "skip_unsupported_primitives to ignore it)");
+                                   "; only triangle primitives (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN) are "
+                                   "supported (load with skip_unsupported_primitives to ignore it)");
         ++skipped;
         continue;
       }
-      const auto pos_it = prim.attributes.find("POSITION");
-      if (pos_it == prim.attributes.end()) {
+      if (prim.attributes.find("POSITION") == prim.attributes.end()) {
         asset->warnings.push_back(label + " has no POSITION attribute and was skipped");
         continue;
       }
-      Eigen::MatrixXd P;
-      Status s = read_gltf_accessor(model, pos_it->second, &P);
-      if (!s.ok()) return Status::error(s.code, name + ": " + label + " POSITION: " + s.message);
-      if (P.cols() != 3)
-        return Status::error(StatusCode::ParseError, name + ": " + label + " POSITION is not VEC3");
+      GltfTriangles tris;
+      if (Status s = read_gltf_triangles(model, prim, label, &tris); !s.ok())
+        return Status::error(s.code, name + ": " + s.message);
+      const Eigen::MatrixXd& P = tris.P;
       const int nv = static_cast<int>(P.rows());
-      Eigen::MatrixXd I;
-      if (prim.indices >= 0) {
-        s = read_gltf_accessor(model, prim.indices, &I);
-        if (!s.ok()) return Status::error(s.code, name + ": " + label + " indices: " + s.message);
-        const int ct = model.accessors[prim.indices].componentType;
-        if (I.cols() != 1 || (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-                               ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
-          return Status::error(StatusCode::ParseError, name + ": " + label + " indices must be unsigned integer scalars");
-      } else {
-        I.resize(nv, 1);
-        for (int k = 0; k < nv; ++k) I(k, 0) = k;
-      }
-      if (I.rows() % 3 != 0)
-        return Status::error(StatusCode::ParseError, name + ": " + label + " has " + std::to_string(I.rows()) +
-                                                         " indices, not a multiple of 3");
-      for (Eigen::Index k = 0; k < I.rows(); ++k)
-        if (I(k, 0) >= nv)
-          return Status::error(StatusCode::ParseError, name + ": " + label + " index " + std::to_string(k) + " is " +
-                                                           std::to_string(static_cast<long long>(I(k, 0))) +
-                                                           " but POSITION has only " + std::to_string(nv) + " vertices");
       PrimitiveRef ref;
       ref.node = item.node;
       ref.mesh = node.mesh;
@@ -394,7 +464,7 @@ Status load_gltf(const std::vector<uint8_t>& bytes, Format format, const FileRes
       ref.first_vertex = static_cast<int>(positions.size());
       ref.num_vertices = nv;
       ref.first_face = static_cast<int>(triangles.size());
-      ref.num_faces = static_cast<int>(I.rows() / 3);
+      ref.num_faces = static_cast<int>(tris.F.rows());
       ref.skinned = node.skin >= 0;
       ref.world = world;
       ref.name = node.name + "/" + mesh.name + "#" + std::to_string(pi);
@@ -403,9 +473,8 @@ Status load_gltf(const std::vector<uint8_t>& bytes, Format format, const FileRes
         positions.emplace_back(p.x(), p.y(), p.z());
       }
       for (int f = 0; f < ref.num_faces; ++f)
-        triangles.emplace_back(ref.first_vertex + static_cast<int>(I(3 * f, 0)),
-                               ref.first_vertex + static_cast<int>(I(3 * f + 1, 0)),
-                               ref.first_vertex + static_cast<int>(I(3 * f + 2, 0)));
+        triangles.emplace_back(ref.first_vertex + tris.F(f, 0), ref.first_vertex + tris.F(f, 1),
+                               ref.first_vertex + tris.F(f, 2));
       asset->primitives.push_back(ref);
     }
   }

@@ -1,4 +1,5 @@
 #include "io/gltf_uri.h"
+#include "io/json_text.h"
 
 #include <cctype>
 
@@ -50,7 +51,7 @@ bool is_data_uri(const std::string& uri) {
 
 Status check_relative_uri(const std::string& uri, const std::string& what) {
   auto refuse = [&](const std::string& why) {
-    return Status::error(StatusCode::IoError, what + " refers to '" + uri + "': " + why +
+    return Status::error(StatusCode::IoError, what + " refers to '" + quote_input(uri) + "': " + why +
                                                   "; only files inside the glTF file's own folder can be used");
   };
   if (uri.empty()) return refuse("empty URI");

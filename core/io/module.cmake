@@ -3,6 +3,7 @@ list(APPEND MM_IO_SOURCES
   core/io/asset.cpp
   core/io/grouped_normals.cpp
   core/io/io_text.cpp
+  core/io/json_text.cpp
   core/io/obj.cpp
   core/io/off.cpp
   core/io/ply.cpp
@@ -14,7 +15,7 @@ list(APPEND MM_IO_SOURCES
   core/io/gltf_save.cpp
   core/io/gltf_export.cpp
   core/io/tinygltf_impl.cpp)
-list(APPEND MM_TEST_SOURCES tests/io_test.cpp tests/io_gltf_test.cpp)
+list(APPEND MM_TEST_SOURCES tests/io_test.cpp tests/io_gltf_test.cpp tests/io_hostile_test.cpp)
 list(APPEND MM_IO_SOURCES core/io/info_report.cpp)  # owned by the lead: the `info` report shared by CLI and wasm
 # glTF skins/animations (read into core/character types) and the morph-target animation writer.
 list(APPEND MM_IO_SOURCES core/io/gltf_animation.cpp core/io/gltf_animation_write.cpp core/io/joints_json.cpp)

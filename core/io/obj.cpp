@@ -8,6 +8,7 @@
 
 #include "io/grouped_normals.h"
 #include "io/io_text.h"
+#include "io/json_text.h"
 
 namespace mm::io {
 
@@ -30,7 +31,7 @@ static int obj_resolve_index(std::string_view token, int count, const char* what
                              std::string* message) {
   long long k = 0;
   if (!parse_int_token(token, &k)) {
-    *message = "line " + std::to_string(line) + ": '" + std::string(token) +
+    *message = "line " + std::to_string(line) + ": '" + quote_input(token) +
                "' is not a valid " + what + " index";
     return -1;
   }
@@ -71,11 +72,11 @@ Status load_obj(const std::vector<uint8_t>& bytes, Asset* asset) {
                                                        std::to_string(line_no) + ": " + what);
     };
     if (key == "v" || key == "vn") {
-      if (tok.size() < 4) return error(std::string("'") + std::string(key) + "' needs 3 coordinates");
+      if (tok.size() < 4) return error(std::string("'") + quote_input(key) + "' needs 3 coordinates");
       double xyz[3];
       for (int c = 0; c < 3; ++c)
         if (!parse_double_token(tok[1 + c], &xyz[c]))
-          return error("'" + std::string(tok[1 + c]) + "' is not a number");
+          return error("'" + quote_input(tok[1 + c]) + "' is not a number");
       auto& dst = key == "v" ? v : vn;
       dst.insert(dst.end(), xyz, xyz + 3);
       (key == "v" ? doc->v_line : doc->vn_line).push_back(static_cast<int>(doc->lines.size()) - 1);
@@ -84,7 +85,7 @@ Status load_obj(const std::vector<uint8_t>& bytes, Asset* asset) {
       double uv[2] = {0, 0};
       for (size_t c = 0; c < 2 && c + 1 < tok.size(); ++c)
         if (!parse_double_token(tok[1 + c], &uv[c]))
-          return error("'" + std::string(tok[1 + c]) + "' is not a number");
+          return error("'" + quote_input(tok[1 + c]) + "' is not a number");
       vt.insert(vt.end(), uv, uv + 2);
     } else if (key == "f") {
       if (tok.size() < 4) return error("face has fewer than 3 corners");
@@ -221,7 +222,7 @@ Status write_obj(const ExportMesh& mesh, std::vector<uint8_t>* out) {
   out->clear();
   append_text(out, "# written by MeshMorph\n");
   auto row3 = [](const char* key, const Eigen::MatrixXd& M, int r) {
-    return std::string(key) + " " + format_double(M(r, 0)) + " " + format_double(M(r, 1)) + " " +
+    return quote_input(key) + " " + format_double(M(r, 0)) + " " + format_double(M(r, 1)) + " " +
            format_double(M(r, 2));
   };
   const bool has_c = mesh.C.rows() == mesh.V.rows() && mesh.C.rows() > 0;

@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "io/io_text.h"
+#include "io/json_text.h"
 
 namespace mm::io {
 
@@ -41,13 +42,13 @@ Status load_off(const std::vector<uint8_t>& bytes, Asset* asset) {
   const size_t off_pos = kw.rfind("OFF");
   if (off_pos == std::string_view::npos || off_pos + 3 != kw.size())
     return error(StatusCode::ParseError, "expected the header keyword 'OFF' (or COFF/NOFF), found '" +
-                                             std::string(kw) + "'");
+                                             quote_input(kw) + "'");
   const std::string_view prefix = kw.substr(0, off_pos);
   for (char c : prefix)
     if (c != 'S' && c != 'T' && c != 'C' && c != 'N')
-      return error(StatusCode::Unsupported, "OFF variant '" + std::string(kw) +
+      return error(StatusCode::Unsupported, "OFF variant '" + quote_input(kw) +
                                                 "' (4D or n-dimensional) is not supported");
-  doc->keyword = std::string(kw);
+  doc->keyword = quote_input(kw);
   size_t first = 1;
   if (tok.size() > 1 && tok[1] == "BINARY")
     return error(StatusCode::Unsupported, "binary OFF is not supported; save it as ASCII OFF or PLY");
@@ -76,7 +77,7 @@ Status load_off(const std::vector<uint8_t>& bytes, Asset* asset) {
     for (int c = 0; c < 3; ++c) {
       double x;
       if (!parse_double_token(tok[c], &x))
-        return error(StatusCode::ParseError, "'" + std::string(tok[c]) + "' is not a number");
+        return error(StatusCode::ParseError, "'" + quote_input(tok[c]) + "' is not a number");
       v.push_back(x);
     }
     const size_t rest = static_cast<size_t>(tok[2].data() + tok[2].size() - stripped.data());
@@ -99,7 +100,7 @@ Status load_off(const std::vector<uint8_t>& bytes, Asset* asset) {
     for (long long c = 0; c < n; ++c) {
       long long k = 0;
       if (!parse_int_token(tok[1 + c], &k))
-        return error(StatusCode::ParseError, "'" + std::string(tok[1 + c]) + "' is not a vertex index");
+        return error(StatusCode::ParseError, "'" + quote_input(tok[1 + c]) + "' is not a vertex index");
       if (k < 0 || k >= nv)
         return error(StatusCode::ParseError, "face references vertex " + std::to_string(k) + " but there are " +
                                                  std::to_string(nv) + " vertices (indices start at 0)");

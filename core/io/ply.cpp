@@ -11,6 +11,7 @@
 
 #include "io/grouped_normals.h"
 #include "io/io_text.h"
+#include "io/json_text.h"
 
 namespace mm::io {
 
@@ -116,7 +117,7 @@ class PlyDataReader {
       if (pos_ == b) return false;
       const std::string_view tok(reinterpret_cast<const char*>(data_) + b, pos_ - b);
       if (!parse_double_token(tok, v)) {
-        bad_token_ = std::string(tok);
+        bad_token_ = quote_input(tok);
         return false;
       }
       return true;
@@ -166,7 +167,7 @@ Status load_ply(const std::vector<uint8_t>& bytes, Asset* asset) {
       if (tok[1] == "ascii") doc->encoding = PlyEncoding::Ascii;
       else if (tok[1] == "binary_little_endian") doc->encoding = PlyEncoding::BinaryLittleEndian;
       else if (tok[1] == "binary_big_endian") doc->encoding = PlyEncoding::BinaryBigEndian;
-      else return fail(StatusCode::Unsupported, where() + "unknown PLY format '" + std::string(tok[1]) + "'");
+      else return fail(StatusCode::Unsupported, where() + "unknown PLY format '" + quote_input(tok[1]) + "'");
       have_format = true;
     } else if (tok[0] == "element") {
       long long count = -1;
@@ -181,19 +182,19 @@ Status load_ply(const std::vector<uint8_t>& bytes, Asset* asset) {
       PlyProperty p;
       if (tok.size() >= 2 && tok[1] == "list") {
         if (tok.size() < 5 || !ply_type_from_name(tok[2], &p.count_type) || !ply_type_from_name(tok[3], &p.type))
-          return fail(StatusCode::ParseError, where() + "malformed list property '" + std::string(line) + "'");
+          return fail(StatusCode::ParseError, where() + "malformed list property '" + quote_input(line) + "'");
         if (!ply_is_integer_type(p.count_type))
           return fail(StatusCode::ParseError, where() + "list count type must be an integer type");
         p.is_list = true;
         p.name = std::string(tok[4]);
       } else {
         if (tok.size() < 3 || !ply_type_from_name(tok[1], &p.type))
-          return fail(StatusCode::ParseError, where() + "malformed property '" + std::string(line) + "'");
+          return fail(StatusCode::ParseError, where() + "malformed property '" + quote_input(line) + "'");
         p.name = std::string(tok[2]);
       }
       doc->elements.back().properties.push_back(std::move(p));
     } else {
-      return fail(StatusCode::ParseError, where() + "unknown header keyword '" + std::string(tok[0]) + "'");
+      return fail(StatusCode::ParseError, where() + "unknown header keyword '" + quote_input(tok[0]) + "'");
     }
   }
   if (!have_end) return fail(StatusCode::ParseError, "PLY header has no 'end_header' line");
