@@ -15,7 +15,7 @@
 #include "edit/selection.h"
 #include "edit/shear_removal.h"
 #include "linalg/polar.h"
-#include "edit/supernodal_cholesky.h"
+#include "linalg/supernodal_cholesky.h"
 #include "linalg/spd_solver.h"
 #include "operators/operators.h"
 #include "edit_test_util.h"

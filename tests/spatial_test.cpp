@@ -1,11 +1,15 @@
-// Tests of core/spatial: BVH closest point / rays / inside test against brute force, and
-// farthest-point sampling invariants.
+// Tests of core/spatial: BVH closest point / rays / inside test against brute force,
+// farthest-point sampling invariants, plane quadrics, and uniform-grid box queries.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "spatial/farthest_point_sampling.h"
+#include "spatial/quadric.h"
 #include "spatial/triangle_bvh.h"
+#include "spatial/uniform_grid.h"
 
 namespace {
 
@@ -161,4 +165,96 @@ TEST(SpatialSampling, SurfaceSamplesCoverFacesUniformly) {
   // Deformed copy: positions follow the vertices.
   const Eigen::MatrixXd V2 = 2 * V;
   EXPECT_LT((S.positions(V2, F) - 2 * S.P).norm(), 1e-12);
+}
+
+TEST(SpatialQuadric, SumOfSquaredPlaneDistancesAndMinimiser) {
+  // Three orthogonal planes x = 1, y = −2, z = 3 (weights 1, 2, 3) meet at (1, −2, 3).
+  mm::Quadric q;
+  q.add_plane(1, 0, 0, 1.0, 1.0);
+  q.add_plane(0, 1, 0, -2.0, 2.0);
+  mm::Quadric r;
+  r.add_plane(0, 0, 1, 3.0, 3.0);
+  q.add(r);
+  EXPECT_DOUBLE_EQ(q.area, 6.0);
+  EXPECT_NEAR(q.eval(1, -2, 3), 0.0, 1e-12);
+  // Q(p) = Σ w (n·p − d)²
+  EXPECT_NEAR(q.eval(0, 0, 0), 1 * 1 + 2 * 4 + 3 * 9, 1e-12);
+  EXPECT_NEAR(q.eval(2, 1, -1), 1 * 1 + 2 * 9 + 3 * 16, 1e-12);
+  double p[3];
+  ASSERT_TRUE(q.minimiser(p));
+  EXPECT_NEAR(p[0], 1, 1e-12);
+  EXPECT_NEAR(p[1], -2, 1e-12);
+  EXPECT_NEAR(p[2], 3, 1e-12);
+  // Parallel planes only (a rank-1 3x3 part): no unique minimiser.
+  mm::Quadric flat;
+  flat.add_plane(0, 0, 1, 0.0, 1.0);
+  flat.add_plane(0, 0, 1, 1.0, 1.0);
+  EXPECT_FALSE(flat.minimiser(p));
+  EXPECT_NEAR(flat.eval(5, 7, 0.5), 0.5, 1e-12);
+  EXPECT_FALSE(mm::Quadric().minimiser(p));
+}
+
+TEST(SpatialGrid, PointGridBoxQueriesMatchBruteForce) {
+  Lcg rng;
+  Eigen::MatrixXd P(2000, 3);
+  for (int i = 0; i < P.rows(); ++i) P.row(i) << rng.next() * 4 - 1, rng.next(), rng.next() * 0.5;
+  const mm::PointGrid grid(P);
+  // 48 cells along the longest side (x), plus one for a point on the far end.
+  EXPECT_GE(grid.grid().dims[0], 48);
+  EXPECT_LE(grid.grid().dims[0], 49);
+  for (int t = 0; t < 50; ++t) {
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+      const double a = rng.next() * 5 - 1.5, b = rng.next() * 5 - 1.5;
+      lo[k] = std::min(a, b) * (k == 0 ? 1.0 : 0.4);
+      hi[k] = std::max(a, b) * (k == 0 ? 1.0 : 0.4);
+    }
+    std::vector<int> got, want;
+    grid.for_each_in_box(lo, hi, [&](int i) {
+      got.push_back(i);
+      return true;
+    });
+    for (int i = 0; i < P.rows(); ++i)
+      if (P(i, 0) >= lo[0] && P(i, 1) >= lo[1] && P(i, 2) >= lo[2] && P(i, 0) <= hi[0] && P(i, 1) <= hi[1] &&
+          P(i, 2) <= hi[2])
+        want.push_back(i);
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, want) << "query " << t;
+  }
+  // Early stop: the callback's false ends the query.
+  int calls = 0;
+  const double all_lo[3] = {-10, -10, -10}, all_hi[3] = {10, 10, 10};
+  EXPECT_FALSE(grid.for_each_in_box(all_lo, all_hi, [&](int) { return ++calls < 5; }));
+  EXPECT_EQ(calls, 5);
+  EXPECT_TRUE(mm::PointGrid(Eigen::MatrixXd(0, 3)).for_each_in_box(all_lo, all_hi, [](int) { return false; }));
+}
+
+TEST(SpatialGrid, BoxGridFilesEntriesUnderOverlappedCellsAndPrunesStale) {
+  mm::UniformGrid g;
+  g.cell = 1;
+  g.dims[0] = g.dims[1] = g.dims[2] = 4;  // [0, 4)³; outside coordinates clamp to the border
+  EXPECT_EQ(g.coord(-3.0, 0), 0);
+  EXPECT_EQ(g.coord(2.5, 1), 2);
+  EXPECT_EQ(g.coord(9.0, 2), 3);
+  mm::BoxGrid<int> bg;
+  bg.reset(g);
+  auto never = [](int) { return false; };
+  bg.insert(Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(1.5, 0.5, 0.5), 7, never);  // cells (0..1, 0, 0)
+  bg.insert(Eigen::Vector3d(3.5, 3.5, 3.5), Eigen::Vector3d(3.6, 3.6, 3.6), 9, never);  // cell (3, 3, 3)
+  auto collect = [&](const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+    std::vector<int> out;
+    bg.for_each_in_box(lo, hi, [&](int e) {
+      out.push_back(e);
+      return true;
+    });
+    return out;
+  };
+  EXPECT_EQ(collect(Eigen::Vector3d(1.2, 0.1, 0.1), Eigen::Vector3d(1.3, 0.2, 0.2)), std::vector<int>{7});
+  EXPECT_EQ(collect(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(4, 4, 4)), (std::vector<int>{7, 7, 9}));
+  EXPECT_TRUE(collect(Eigen::Vector3d(2.1, 2.1, 2.1), Eigen::Vector3d(2.2, 2.2, 2.2)).empty());
+  // 16 entries in one cell, then the 17th insert prunes the stale (odd) ones first.
+  for (int e = 0; e < 16; ++e) bg.insert(Eigen::Vector3d(2.5, 2.5, 2.5), Eigen::Vector3d(2.5, 2.5, 2.5), e, never);
+  bg.insert(Eigen::Vector3d(2.5, 2.5, 2.5), Eigen::Vector3d(2.5, 2.5, 2.5), 100, [](int e) { return e % 2 == 1; });
+  const std::vector<int> cell = collect(Eigen::Vector3d(2.5, 2.5, 2.5), Eigen::Vector3d(2.5, 2.5, 2.5));
+  EXPECT_EQ(cell, (std::vector<int>{0, 2, 4, 6, 8, 10, 12, 14, 100}));
 }

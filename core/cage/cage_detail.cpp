@@ -2,42 +2,15 @@
 
 #include <algorithm>
 
+#include "spatial/point_triangle.h"
+
 namespace mm::cage_detail {
 
 double point_triangle_distance2(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  // Voronoi-region walk of Ericson 5.1.5; returns |p − closest|².
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return dot(ap, ap);
-  const Vec3 bp = p - b;
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return dot(bp, bp);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-    const double v = d1 / (d1 - d3);
-    const Vec3 q = a + v * ab;
-    return dot(p - q, p - q);
-  }
-  const Vec3 cp = p - c;
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return dot(cp, cp);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-    const double w = d2 / (d2 - d6);
-    const Vec3 q = a + w * ac;
-    return dot(p - q, p - q);
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    const Vec3 q = b + w * (c - b);
-    return dot(p - q, p - q);
-  }
-  const double denom = va + vb + vc;
-  if (!(std::abs(denom) > 0)) return std::min({dot(ap, ap), dot(bp, bp), dot(cp, cp)});
-  const double v = vb / denom, w = vc / denom;
-  const Vec3 q = a + v * ab + w * ac;
-  return dot(p - q, p - q);
+  // Ericson 5.1.5 (spatial/point_triangle.h) in scalar Vec3 arithmetic; returns |p − closest|².
+  const Vec3 d = p - closest_point_on_triangle_t(
+                         p, a, b, c, [](const Vec3& x, const Vec3& y) { return dot(x, y); }, nullptr);
+  return dot(d, d);
 }
 
 namespace {

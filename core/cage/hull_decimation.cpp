@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "cage/cage_detail.h"
+#include "spatial/quadric.h"
+#include "spatial/uniform_grid.h"
 
 namespace mm {
 
@@ -18,39 +20,6 @@ using cage_detail::dot;
 using cage_detail::norm;
 
 constexpr double kPi = 3.14159265358979323846;
-
-// Area-weighted plane quadric: Q(p) = Σ area·(n·p − d)², stored as the symmetric 4x4.
-struct Quadric {
-  double a00 = 0, a01 = 0, a02 = 0, a11 = 0, a12 = 0, a22 = 0, b0 = 0, b1 = 0, b2 = 0, c = 0, area = 0;
-  void add_plane(const Vec3& n, double d, double w) {
-    a00 += w * n.x * n.x; a01 += w * n.x * n.y; a02 += w * n.x * n.z;
-    a11 += w * n.y * n.y; a12 += w * n.y * n.z; a22 += w * n.z * n.z;
-    b0 -= w * n.x * d; b1 -= w * n.y * d; b2 -= w * n.z * d;
-    c += w * d * d;
-    area += w;
-  }
-  void add(const Quadric& q) {
-    a00 += q.a00; a01 += q.a01; a02 += q.a02; a11 += q.a11; a12 += q.a12; a22 += q.a22;
-    b0 += q.b0; b1 += q.b1; b2 += q.b2; c += q.c; area += q.area;
-  }
-  double eval(const Vec3& p) const {
-    const double x = p.x, y = p.y, z = p.z;
-    return a00 * x * x + 2 * a01 * x * y + 2 * a02 * x * z + a11 * y * y + 2 * a12 * y * z + a22 * z * z +
-           2 * (b0 * x + b1 * y + b2 * z) + c;
-  }
-  // Minimiser of Q when the 3x3 part is well conditioned.
-  bool minimiser(Vec3* p) const {
-    const double c00 = a11 * a22 - a12 * a12, c01 = a02 * a12 - a01 * a22, c02 = a01 * a12 - a02 * a11;
-    const double det = a00 * c00 + a01 * c01 + a02 * c02;
-    const double tr = (a00 + a11 + a22) / 3;
-    if (!(tr > 0) || !(std::abs(det) > 1e-6 * tr * tr * tr)) return false;
-    const double c11 = a00 * a22 - a02 * a02, c12 = a01 * a02 - a00 * a12, c22 = a00 * a11 - a01 * a01;
-    const double inv = 1.0 / det;
-    *p = Vec3(-(c00 * b0 + c01 * b1 + c02 * b2) * inv, -(c01 * b0 + c11 * b1 + c12 * b2) * inv,
-              -(c02 * b0 + c12 * b1 + c22 * b2) * inv);
-    return std::isfinite(p->x) && std::isfinite(p->y) && std::isfinite(p->z);
-  }
-};
 
 struct HeapEntry {
   double cost;
@@ -121,73 +90,11 @@ double hull_solid_angle(const Vec3& x, const Vec3& a, const Vec3& b, const Vec3&
   return 2.0 * std::atan2(det, den);
 }
 
-// Points in a uniform grid (CSR layout) for box queries.
-class PointGrid {
- public:
-  PointGrid(const Eigen::MatrixXd& P) : P_(P) {
-    const int n = static_cast<int>(P.rows());
-    if (n == 0) return;
-    Vec3 lo(P(0, 0), P(0, 1), P(0, 2)), hi = lo;
-    for (int i = 0; i < n; ++i) {
-      lo = Vec3(std::min(lo.x, P(i, 0)), std::min(lo.y, P(i, 1)), std::min(lo.z, P(i, 2)));
-      hi = Vec3(std::max(hi.x, P(i, 0)), std::max(hi.y, P(i, 1)), std::max(hi.z, P(i, 2)));
-    }
-    lo_ = lo;
-    const double longest = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, 1e-300});
-    cell_ = longest / 48.0;
-    for (int k = 0; k < 3; ++k) dims_[k] = static_cast<int>(std::floor((hi[k] - lo[k]) / cell_)) + 1;
-    std::vector<int> cell_of(n);
-    start_.assign(static_cast<size_t>(dims_[0]) * dims_[1] * dims_[2] + 1, 0);
-    for (int i = 0; i < n; ++i) {
-      cell_of[i] = cell_index(coord(P(i, 0), 0), coord(P(i, 1), 1), coord(P(i, 2), 2));
-      ++start_[cell_of[i] + 1];
-    }
-    for (size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
-    ids_.resize(n);
-    std::vector<int> fill(start_.begin(), start_.end() - 1);
-    for (int i = 0; i < n; ++i) ids_[fill[cell_of[i]]++] = i;
-  }
-
-  // Calls fn(i, point) for every point in the box [lo, hi].
-  template <class Fn>
-  bool for_each_in_box(const Vec3& lo, const Vec3& hi, Fn fn) const {
-    if (ids_.empty()) return true;
-    int r0[3], r1[3];
-    for (int k = 0; k < 3; ++k) {
-      r0[k] = coord(lo[k], k);
-      r1[k] = coord(hi[k], k);
-    }
-    for (int z = r0[2]; z <= r1[2]; ++z)
-      for (int y = r0[1]; y <= r1[1]; ++y)
-        for (int x = r0[0]; x <= r1[0]; ++x) {
-          const int c = cell_index(x, y, z);
-          for (int s = start_[c]; s < start_[c + 1]; ++s) {
-            const int i = ids_[s];
-            const Vec3 p(P_(i, 0), P_(i, 1), P_(i, 2));
-            if (p.x < lo.x || p.y < lo.y || p.z < lo.z || p.x > hi.x || p.y > hi.y || p.z > hi.z) continue;
-            if (!fn(p)) return false;
-          }
-        }
-    return true;
-  }
-
- private:
-  int coord(double v, int k) const {
-    return std::clamp(static_cast<int>(std::floor((v - lo_[k]) / cell_)), 0, dims_[k] - 1);
-  }
-  int cell_index(int x, int y, int z) const { return x + dims_[0] * (y + dims_[1] * z); }
-  const Eigen::MatrixXd& P_;
-  Vec3 lo_;
-  double cell_ = 1;
-  int dims_[3] = {1, 1, 1};
-  std::vector<int> start_, ids_;
-};
-
 class Decimator {
  public:
   Decimator(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Eigen::MatrixXd& P, double clearance,
             const HullDecimationOptions& opt)
-      : opt_(opt), points_(P), clearance_(clearance) {
+      : opt_(opt), point_pos_(P), points_(P), clearance_(clearance) {
     const int n = static_cast<int>(V.rows());
     pos_.resize(n);
     for (int i = 0; i < n; ++i) pos_[i] = Vec3(V(i, 0), V(i, 1), V(i, 2));
@@ -208,7 +115,7 @@ class Decimator {
       if (a2 > 0) {
         const Vec3 nrm = (1.0 / a2) * A;
         const double d = dot(nrm, pos_[faces_[f][0]]);
-        for (int c = 0; c < 3; ++c) quadric_[F(f, c)].add_plane(nrm, d, 0.5 * a2);
+        for (int c = 0; c < 3; ++c) quadric_[F(f, c)].add_plane(nrm.x, nrm.y, nrm.z, d, 0.5 * a2);
       }
     }
     alive_vertices_ = 0;
@@ -313,15 +220,18 @@ class Decimator {
     const double len = std::sqrt(len2);
     Vec3 cand[4];
     int nc = 0;
-    Vec3 opt_p;
-    if (q.minimiser(&opt_p) && norm(opt_p - mid) < len) cand[nc++] = opt_p;
+    double m[3];
+    if (q.minimiser(m)) {
+      const Vec3 opt_p(m[0], m[1], m[2]);
+      if (norm(opt_p - mid) < len) cand[nc++] = opt_p;
+    }
     cand[nc++] = mid;
     cand[nc++] = pa;
     cand[nc++] = pb;
     const double norm_area = q.area > 0 ? q.area : 1.0;
     for (int i = 0; i < nc; ++i) {
       out.p[i] = cand[i];
-      out.cost[i] = std::max(0.0, q.eval(cand[i])) / norm_area + opt_.length_weight * len2;
+      out.cost[i] = std::max(0.0, q.eval(cand[i].x, cand[i].y, cand[i].z)) / norm_area + opt_.length_weight * len2;
     }
     out.n = nc;
     // Insertion sort, stable (deterministic order for equal costs).
@@ -407,7 +317,8 @@ class Decimator {
     // new star, which lies in the bounding box of their vertices.
     const Vec3 pad(clearance_, clearance_, clearance_);
     const double c2 = clearance_ * clearance_;
-    return points_.for_each_in_box(lo - pad, hi + pad, [&](const Vec3& x) {
+    return points_.for_each_in_box(lo - pad, hi + pad, [&](int i) {
+      const Vec3 x(point_pos_(i, 0), point_pos_(i, 1), point_pos_(i, 2));
       double delta = 0;
       for (const auto& P : moved) {
         if (clearance_ > 0 && cage_detail::point_triangle_distance2(x, P[0], P[1], P[2]) < c2) return false;
@@ -458,20 +369,17 @@ class Decimator {
     double cs = 2.0 * edge_sum / std::max(1, edges);
     const double longest = std::max({ext.x, ext.y, ext.z, 1e-300});
     cs = std::max(cs, longest / 96.0);  // at most ~96 cells along the longest side
-    grid_lo_ = lo - Vec3(cs, cs, cs);
-    cell_ = cs;
-    for (int k = 0; k < 3; ++k) dims_[k] = static_cast<int>(std::ceil((ext[k] + 2 * cs) / cs)) + 1;
-    cells_.assign(static_cast<size_t>(dims_[0]) * dims_[1] * dims_[2], {});
+    UniformGrid g;
+    const Vec3 glo = lo - Vec3(cs, cs, cs);
+    g.cell = cs;
+    for (int k = 0; k < 3; ++k) {
+      g.lo[k] = glo[k];
+      g.dims[k] = static_cast<int>(std::ceil((ext[k] + 2 * cs) / cs)) + 1;
+    }
+    face_grid_.reset(g);
     for (size_t f = 0; f < faces_.size(); ++f)
       if (face_alive_[f]) grid_insert(static_cast<int>(f));
     grid_faces_ = alive_faces_;
-  }
-
-  void cell_range(const Vec3& lo, const Vec3& hi, int r0[3], int r1[3]) const {
-    for (int k = 0; k < 3; ++k) {
-      r0[k] = std::clamp(static_cast<int>(std::floor((lo[k] - grid_lo_[k]) / cell_)), 0, dims_[k] - 1);
-      r1[k] = std::clamp(static_cast<int>(std::floor((hi[k] - grid_lo_[k]) / cell_)), 0, dims_[k] - 1);
-    }
   }
 
   static void bbox(const std::array<Vec3, 3>& P, Vec3* lo, Vec3* hi) {
@@ -502,23 +410,11 @@ class Decimator {
     e.f = f;
     e.version = ++face_version_[f];
     float_box(lo, hi, e.lo, e.hi);
-    int r0[3], r1[3];
-    cell_range(lo, hi, r0, r1);
-    for (int z = r0[2]; z <= r1[2]; ++z)
-      for (int y = r0[1]; y <= r1[1]; ++y)
-        for (int x = r0[0]; x <= r1[0]; ++x) {
-          auto& cell = cells_[x + static_cast<size_t>(dims_[0]) * (y + static_cast<size_t>(dims_[1]) * z)];
-          // Faces are re-inserted after every change: drop dead and superseded entries whenever
-          // a cell doubles so cells stay short.
-          if (cell.size() >= 16 && (cell.size() & (cell.size() - 1)) == 0) {
-            cell.erase(std::remove_if(cell.begin(), cell.end(),
-                                      [&](const CellEntry& c) {
-                                        return !face_alive_[c.f] || c.version != face_version_[c.f];
-                                      }),
-                       cell.end());
-          }
-          cell.push_back(e);
-        }
+    // Faces are re-inserted after every change: dead and superseded entries are dropped as
+    // cells grow, so cells stay short.
+    face_grid_.insert(lo, hi, e, [&](const CellEntry& c) {
+      return !face_alive_[c.f] || c.version != face_version_[c.f];
+    });
   }
 
   // True when one of the moved faces crosses a face that shares no vertex with it. One grid
@@ -533,43 +429,38 @@ class Decimator {
       lo = k == 0 ? mlo[k] : Vec3(std::min(lo.x, mlo[k].x), std::min(lo.y, mlo[k].y), std::min(lo.z, mlo[k].z));
       hi = k == 0 ? mhi[k] : Vec3(std::max(hi.x, mhi[k].x), std::max(hi.y, mhi[k].y), std::max(hi.z, mhi[k].z));
     }
-    int r0[3], r1[3];
-    cell_range(lo, hi, r0, r1);
     ++query_;
-    for (int z = r0[2]; z <= r1[2]; ++z)
-      for (int y = r0[1]; y <= r1[1]; ++y)
-        for (int x = r0[0]; x <= r1[0]; ++x) {
-          const auto& cell = cells_[x + static_cast<size_t>(dims_[0]) * (y + static_cast<size_t>(dims_[1]) * z)];
-          for (const CellEntry& ce : cell) {
-            // The entry's stored box (rounded outward) rejects most candidates without touching
-            // the face arrays; superseded entries (the face moved since) are skipped.
-            if (ce.lo[0] > hi.x || ce.lo[1] > hi.y || ce.lo[2] > hi.z || ce.hi[0] < lo.x || ce.hi[1] < lo.y ||
-                ce.hi[2] < lo.z)
-              continue;
-            const int g = ce.f;
-            if (ce.version != face_version_[g] || stamp_[g] == query_ || !face_alive_[g]) continue;
-            stamp_[g] = query_;
-            const auto& t = faces_[g];
-            if (has_vertex(t, a) || has_vertex(t, b)) continue;  // part of the star
-            const auto Q = face_points(g);
-            Vec3 qlo, qhi;
-            bbox(Q, &qlo, &qhi);
-            if (qlo.x > hi.x || qlo.y > hi.y || qlo.z > hi.z || qhi.x < lo.x || qhi.y < lo.y || qhi.z < lo.z)
-              continue;
-            for (size_t k = 0; k < moved.size(); ++k) {
-              if (qlo.x > mhi[k].x || qlo.y > mhi[k].y || qlo.z > mhi[k].z || qhi.x < mlo[k].x ||
-                  qhi.y < mlo[k].y || qhi.z < mlo[k].z)
-                continue;
-              if (has_vertex(t, ids[k][0]) || has_vertex(t, ids[k][1]) || has_vertex(t, ids[k][2])) continue;
-              const auto& P = moved[k];
-              if (cage_detail::triangles_intersect(P[0], P[1], P[2], Q[0], Q[1], Q[2])) return true;
-            }
-          }
-        }
-    return false;
+    // The entry's stored box (rounded outward) rejects most candidates without touching the
+    // face arrays; superseded entries (the face moved since) are skipped.
+    const bool clear = face_grid_.for_each_in_box(lo, hi, [&](const CellEntry& ce) {
+      if (ce.lo[0] > hi.x || ce.lo[1] > hi.y || ce.lo[2] > hi.z || ce.hi[0] < lo.x || ce.hi[1] < lo.y ||
+          ce.hi[2] < lo.z)
+        return true;
+      const int g = ce.f;
+      if (ce.version != face_version_[g] || stamp_[g] == query_ || !face_alive_[g]) return true;
+      stamp_[g] = query_;
+      const auto& t = faces_[g];
+      if (has_vertex(t, a) || has_vertex(t, b)) return true;  // part of the star
+      const auto Q = face_points(g);
+      Vec3 qlo, qhi;
+      bbox(Q, &qlo, &qhi);
+      if (qlo.x > hi.x || qlo.y > hi.y || qlo.z > hi.z || qhi.x < lo.x || qhi.y < lo.y || qhi.z < lo.z)
+        return true;
+      for (size_t k = 0; k < moved.size(); ++k) {
+        if (qlo.x > mhi[k].x || qlo.y > mhi[k].y || qlo.z > mhi[k].z || qhi.x < mlo[k].x ||
+            qhi.y < mlo[k].y || qhi.z < mlo[k].z)
+          continue;
+        if (has_vertex(t, ids[k][0]) || has_vertex(t, ids[k][1]) || has_vertex(t, ids[k][2])) continue;
+        const auto& P = moved[k];
+        if (cage_detail::triangles_intersect(P[0], P[1], P[2], Q[0], Q[1], Q[2])) return false;  // hit
+      }
+      return true;
+    });
+    return !clear;
   }
 
   HullDecimationOptions opt_;
+  const Eigen::MatrixXd& point_pos_;  // the points to keep inside (rows)
   PointGrid points_;
   double clearance_ = 0;
   double cos_turn_ = 0;
@@ -582,16 +473,12 @@ class Decimator {
   std::vector<unsigned> version_;  // bumped whenever a vertex moves (heap lazy deletion)
   EdgeHeap heap_;
   int alive_vertices_ = 0, alive_faces_ = 0, grid_faces_ = 0;
-  // grid over faces
-  Vec3 grid_lo_;
-  double cell_ = 1;
-  int dims_[3] = {1, 1, 1};
   struct CellEntry {
     int f;
-    unsigned version;  // face_version_[f] when inserted
+    unsigned version;    // face_version_[f] when inserted
     float lo[3], hi[3];  // bounding box of the face then, rounded outward
   };
-  std::vector<std::vector<CellEntry>> cells_;
+  BoxGrid<CellEntry> face_grid_;  // faces by bounding box, rebuilt as faces grow
   std::vector<unsigned> face_version_;
   std::vector<unsigned> stamp_;
   unsigned query_ = 0;

@@ -7,4 +7,4 @@ list(APPEND MM_CORE_SOURCES
   core/cage/cage_containment.cpp
   core/cage/enclosing_cage.cpp
   core/cage/mean_value_coordinates.cpp)
-list(APPEND MM_TEST_SOURCES tests/cage_test.cpp)
+list(APPEND MM_TEST_SOURCES tests/cage_test.cpp tests/hull_decimation_test.cpp tests/offset_surface_test.cpp)

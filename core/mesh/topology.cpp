@@ -101,6 +101,42 @@ std::vector<EdgeUse> edge_uses(const Eigen::MatrixXi& F) {
   return out;
 }
 
+std::vector<VertexFans> non_manifold_vertices(const Eigen::MatrixXi& F, int n, const std::vector<char>* only) {
+  std::vector<std::vector<int>> vf(n);
+  for (int f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c)
+      if (!only || (*only)[F(f, c)]) vf[F(f, c)].push_back(f);
+  std::vector<VertexFans> out;
+  std::vector<int> parent;
+  std::vector<std::pair<int, int>> spokes;
+  for (int v = 0; v < n; ++v) {
+    const auto& faces = vf[v];
+    if (faces.size() < 2) continue;
+    parent.resize(faces.size());
+    std::iota(parent.begin(), parent.end(), 0);
+    auto find = [&parent](int x) {
+      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    // (other vertex, local face) pairs; faces sharing an other vertex share an edge at v.
+    spokes.clear();
+    for (size_t k = 0; k < faces.size(); ++k)
+      for (int c = 0; c < 3; ++c)
+        if (F(faces[k], c) != v) spokes.push_back({F(faces[k], c), static_cast<int>(k)});
+    std::sort(spokes.begin(), spokes.end());
+    for (size_t s = 1; s < spokes.size(); ++s)
+      if (spokes[s].first == spokes[s - 1].first) {
+        const int ra = find(spokes[s].second), rb = find(spokes[s - 1].second);
+        if (ra != rb) parent[ra] = rb;
+      }
+    int fans = 0;
+    for (size_t k = 0; k < faces.size(); ++k)
+      if (find(static_cast<int>(k)) == static_cast<int>(k)) ++fans;
+    if (fans > 1) out.push_back({v, fans});
+  }
+  return out;
+}
+
 std::vector<std::vector<int>> boundary_loops(const Eigen::MatrixXi& F, int n) {
   // Directed boundary half-edges a->b (face order) whose edge is used by exactly one face.
   std::map<std::pair<int, int>, int> count;

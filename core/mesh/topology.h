@@ -38,4 +38,15 @@ struct EdgeUse {
 };
 std::vector<EdgeUse> edge_uses(const Eigen::MatrixXi& F);
 
+// Non-manifold vertices: the faces around a vertex must form one fan (faces connected through
+// edges incident to the vertex). Returns (vertex, number of fans) for every vertex with more
+// than one fan, ascending. F: faces without repeated indices; `only` (size n) restricts the
+// check to the marked vertices. Non-manifold edges are the edge_uses with faces > 2.
+struct VertexFans {
+  int vertex;
+  int fans;
+};
+std::vector<VertexFans> non_manifold_vertices(const Eigen::MatrixXi& F, int n,
+                                              const std::vector<char>* only = nullptr);
+
 }  // namespace mm

@@ -217,42 +217,11 @@ MeshReport validate_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
         });
   }
 
-  // Non-manifold vertices: the faces around a vertex must form one fan (connected through
-  // edges incident to the vertex).
-  {
-    std::vector<std::vector<int>> vf(n);
-    for (int f = 0; f < rows; ++f)
-      for (int c = 0; c < 3; ++c) vf[Fv(f, c)].push_back(f);
-    std::vector<int> parent;
-    for (int v = 0; v < n; ++v) {
-      const auto& faces = vf[v];
-      if (faces.size() < 2) continue;
-      parent.resize(faces.size());
-      std::iota(parent.begin(), parent.end(), 0);
-      auto find = [&parent](int x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-      };
-      // (other vertex, local face) pairs; faces sharing an other vertex share an edge at v.
-      std::vector<std::pair<int, int>> spokes;
-      for (size_t k = 0; k < faces.size(); ++k)
-        for (int c = 0; c < 3; ++c)
-          if (Fv(faces[k], c) != v) spokes.push_back({Fv(faces[k], c), static_cast<int>(k)});
-      std::sort(spokes.begin(), spokes.end());
-      for (size_t s = 1; s < spokes.size(); ++s)
-        if (spokes[s].first == spokes[s - 1].first) {
-          const int ra = find(spokes[s].second), rb = find(spokes[s - 1].second);
-          if (ra != rb) parent[ra] = rb;
-        }
-      int fans = 0;
-      for (size_t k = 0; k < faces.size(); ++k)
-        if (find(static_cast<int>(k)) == static_cast<int>(k)) ++fans;
-      if (fans > 1)
-        nm_vertex.add_lazy([&] {
-          return "vertex " + std::to_string(v) + " joins " + std::to_string(fans) + " fans";
-        });
-    }
-  }
+  // Non-manifold vertices: the faces around a vertex must form one fan (mesh/topology.h).
+  for (const VertexFans& nv : non_manifold_vertices(Fv, n))
+    nm_vertex.add_lazy([&] {
+      return "vertex " + std::to_string(nv.vertex) + " joins " + std::to_string(nv.fans) + " fans";
+    });
 
   // Components and boundary loops over referenced vertices.
   int ncomp = 0;

@@ -8,6 +8,7 @@
 #include <Eigen/SVD>
 
 #include "linalg/polar.h"
+#include "linalg/rigid_fit.h"
 #include "mesh/topology.h"
 #include "operators/operators.h"
 
@@ -15,21 +16,16 @@ namespace mm {
 
 namespace edit_metrics_detail {
 
-// Umeyama fit of a similarity between two point sets (rows). Returns the rotation and writes the
-// residual sum of squares.
+// Umeyama fit of a similarity between two point sets (rows; linalg/rigid_fit.h). Returns the
+// rotation and writes the residual sum of squares and Σ|q − q̄|².
 Eigen::Matrix3d edit_metrics_umeyama(const Eigen::MatrixXd& P, const Eigen::MatrixXd& Q, double* residual2,
-                                 double* q_spread2) {
-  const Eigen::RowVector3d pc = P.colwise().mean(), qc = Q.colwise().mean();
-  const Eigen::MatrixXd P0 = P.rowwise() - pc, Q0 = Q.rowwise() - qc;
-  const Eigen::Matrix3d C = Q0.transpose() * P0;
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(C, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
-  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) D(2, 2) = -1;
-  const double p2 = P0.squaredNorm(), q2 = Q0.squaredNorm();
-  const double tr = (svd.singularValues().asDiagonal() * D).trace();
-  if (residual2) *residual2 = p2 > 0 ? std::max(0.0, q2 - tr * tr / p2) : q2;
-  if (q_spread2) *q_spread2 = q2;
-  return svd.matrixU() * D * svd.matrixV().transpose();
+                                     double* q_spread2) {
+  RigidFitOptions o;
+  o.scale = true;
+  const RigidFit fit = fit_rigid(P, Q, o);
+  if (residual2) *residual2 = fit.residual2;
+  if (q_spread2) *q_spread2 = fit.target_spread2;
+  return fit.R;
 }
 
 Eigen::MatrixXd edit_metrics_ring_points(const Eigen::MatrixXd& X, int i, const std::vector<int>& ring) {

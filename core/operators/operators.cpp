@@ -113,16 +113,28 @@ Eigen::MatrixXd face_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F)
 }
 
 Eigen::MatrixXd vertex_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
-  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(V.rows(), 3);
+  return grouped_vertex_normals(V, F, F, static_cast<int>(V.rows()));
+}
+
+Eigen::MatrixXd grouped_vertex_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Eigen::MatrixXi& G,
+                                       int num_groups) {
+  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(num_groups, 3);
+  const int nv = static_cast<int>(V.rows());
   for (int f = 0; f < F.rows(); ++f) {
+    bool ok = true;
+    for (int c = 0; c < 3; ++c) ok = ok && F(f, c) >= 0 && F(f, c) < nv;
+    if (!ok) continue;
     // Unnormalised cross product = 2·area·normal: area weighting for free.
     const Eigen::Vector3d n = (row3(V, F(f, 1)) - row3(V, F(f, 0))).cross(row3(V, F(f, 2)) - row3(V, F(f, 0)));
     if (!n.allFinite()) continue;
-    for (int c = 0; c < 3; ++c) N.row(F(f, c)) += n.transpose();
+    for (int k = 0; k < 3; ++k) {
+      const int g = G(f, k);
+      if (g >= 0 && g < num_groups) N.row(g) += n.transpose();
+    }
   }
-  for (int v = 0; v < N.rows(); ++v) {
-    const double len = N.row(v).norm();
-    if (len > 0) N.row(v) /= len;
+  for (int g = 0; g < num_groups; ++g) {
+    const double len = N.row(g).norm();
+    if (len > 0) N.row(g) /= len;
   }
   return N;
 }

@@ -43,7 +43,15 @@ Eigen::MatrixXd face_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F)
 
 // Per-vertex unit normals (#V by 3), area-weighted average of incident face normals.
 // Vertices with no non-degenerate incident face get a zero row.
+// = grouped_vertex_normals(V, F, F, #V).
 Eigen::MatrixXd vertex_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+
+// Area-weighted unit normals of groups of face corners (#groups by 3): corner k of face f adds
+// the face's area vector (b − a) × (c − a) to group G(f, k) (G: #F by 3, e.g. vertices welded
+// across seams, or normal indices of an OBJ). Faces with an out-of-range index or a non-finite
+// area vector and corners with an out-of-range group are skipped; empty groups get a zero row.
+Eigen::MatrixXd grouped_vertex_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Eigen::MatrixXi& G,
+                                       int num_groups);
 
 // Per-face areas (#F).
 Eigen::VectorXd face_areas(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);

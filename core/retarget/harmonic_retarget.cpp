@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include <Eigen/Geometry>
-#include <Eigen/SVD>
 
+#include "linalg/rigid_fit.h"
 #include "mesh/mesh.h"
 #include "retarget/bone_correspondence.h"
 #include "retarget/mfs_kernel.h"
@@ -19,38 +19,15 @@ Eigen::RowVector3d bbox_center(const Eigen::MatrixXd& V) {
   return 0.5 * (V.colwise().minCoeff() + V.colwise().maxCoeff());
 }
 
-// Rotation R with R·t ≈ s for centred point sets (Kabsch), snapped to the nearest of the 24
-// axis-aligned rotations: files differ by axis conventions (Y-up vs Z-up, facing ±X/±Z), while
-// a general rotation fitted to joints of differently shaped characters would be noise (a walk
-// would come out slightly sideways). Identity when the joints do not fix a rotation.
-Eigen::Matrix3d snapped_alignment(const Eigen::MatrixXd& S, const Eigen::MatrixXd& T) {
-  if (S.rows() < 3) return Eigen::Matrix3d::Identity();
-  const Eigen::MatrixXd Sc = S.rowwise() - S.colwise().mean();
-  const Eigen::MatrixXd Tc = T.rowwise() - T.colwise().mean();
-  const Eigen::Matrix3d H = Tc.transpose() * Sc;  // Σ t sᵀ
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  if (!(svd.singularValues()[1] > 1e-6 * svd.singularValues()[0])) return Eigen::Matrix3d::Identity();
-  Eigen::Matrix3d Rk = svd.matrixV() * svd.matrixU().transpose();
-  if (Rk.determinant() < 0) {
-    Eigen::Matrix3d Vm = svd.matrixV();
-    Vm.col(2) *= -1;
-    Rk = Vm * svd.matrixU().transpose();
-  }
-  Eigen::Matrix3d best = Eigen::Matrix3d::Identity();
-  double best_score = -1e300;
-  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  for (const auto& p : perms)
-    for (int signs = 0; signs < 8; ++signs) {
-      Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
-      for (int r = 0; r < 3; ++r) C(r, p[r]) = (signs >> r & 1) ? -1.0 : 1.0;
-      if (C.determinant() < 0) continue;
-      const double score = (C.transpose() * Rk).trace();
-      if (score > best_score + 1e-12) {
-        best_score = score;
-        best = C;
-      }
-    }
-  return best;
+// Rotation R with R·t ≈ s for the joints (Kabsch, linalg/rigid_fit.h), snapped to the nearest of
+// the 24 axis-aligned rotations: files differ by axis conventions (Y-up vs Z-up, facing ±X/±Z),
+// while a general rotation fitted to joints of differently shaped characters would be noise (a
+// walk would come out slightly sideways). Identity when the joints do not fix a rotation.
+RigidFitOptions snapped_alignment_options() {
+  RigidFitOptions o;
+  o.snap_to_axes = true;
+  o.min_spread = 1e-6;
+  return o;
 }
 
 Eigen::MatrixXd to_working(const Eigen::MatrixXd& V, const Eigen::RowVector3d& c, double L, const Eigen::Matrix3d& R) {
@@ -99,7 +76,7 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
       S.row(i) = source.joints.P.row(match.pairs[i].source);
       T.row(i) = target.joints.P.row(match.pairs[i].target);
     }
-    R_ = opt.align_axes ? snapped_alignment(S, T) : Eigen::Matrix3d::Identity();
+    R_ = opt.align_axes ? fit_rigid(T, S, snapped_alignment_options()).R : Eigen::Matrix3d::Identity();
   }
   const Eigen::MatrixXd Xs = to_working(source.V, cs_, Ls_, Eigen::Matrix3d::Identity());
   const Eigen::MatrixXd Xt = to_working(target.V, ct_, Lt_, R_);

@@ -3,14 +3,11 @@
 #include <algorithm>
 #include <map>
 
+#include "linalg/rigid_fit.h"
 #include "mesh/mesh.h"
 #include "spatial/triangle_bvh.h"
 
 namespace mm {
-
-namespace retarget_detail {
-Eigen::Matrix3d snapped_alignment(const Eigen::MatrixXd& S, const Eigen::MatrixXd& T);  // harmonic_retarget.cpp
-}
 
 Eigen::Matrix4d Similarity::matrix() const {
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
@@ -35,14 +32,19 @@ Similarity align_rest_poses(const JointSet& source, const JointSet& target, cons
       S.row(i) = source.P.row(pairs[i].source);
       T.row(i) = target.P.row(pairs[i].target);
     }
-    A.R = retarget_detail::snapped_alignment(S, T);
-    const Eigen::RowVector3d ms = S.colwise().mean(), mt = T.colwise().mean();
-    const Eigen::MatrixXd Tr = (T.rowwise() - mt) * A.R.transpose();
-    const Eigen::MatrixXd Sc = S.rowwise() - ms;
-    const double den = Tr.squaredNorm();
-    A.s = den > 0 ? (Tr.cwiseProduct(Sc)).sum() / den : 1.0;
-    if (!(A.s > 0)) A.s = bounding_box_diagonal(V_source) / std::max(1e-300, bounding_box_diagonal(V_target));
-    A.t = (ms - A.s * mt * A.R.transpose()).transpose();
+    // Target joints onto source joints: rotation snapped to the 24 axis-aligned ones (as
+    // harmonic_retarget), scale and translation least-squares for that rotation.
+    RigidFitOptions o;
+    o.scale = o.snap_to_axes = true;
+    o.min_spread = 1e-6;
+    const RigidFit fit = fit_rigid(T, S, o);
+    A.R = fit.R;
+    A.s = fit.s;
+    A.t = fit.t;
+    if (!(A.s > 0)) {
+      A.s = bounding_box_diagonal(V_source) / std::max(1e-300, bounding_box_diagonal(V_target));
+      A.t = (S.colwise().mean() - A.s * T.colwise().mean() * A.R.transpose()).transpose();
+    }
     return A;
   }
   A.s = bounding_box_diagonal(V_source) / std::max(1e-300, bounding_box_diagonal(V_target));

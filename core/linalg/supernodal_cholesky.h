@@ -6,8 +6,8 @@
 // fundamental supernodes with relaxed amalgamation, and dense Eigen kernels (LLT, triangular
 // solve, rank-k update) on each frontal matrix. Against Eigen::SimplicialLDLT (column by column,
 // no dense kernels) this measured 2.5× (52k vertices) to 3.7× (14.6k) faster on these matrices,
-// and it solves several right-hand sides at once with matrix-matrix products. Experimental outside core/edit (only tested on SPD systems of
-// this kind); linalg/spd_solver.h stays the general-purpose solver.
+// and it solves several right-hand sides at once with matrix-matrix products. Used by core/edit; experimental elsewhere (only tested on SPD systems
+// of this kind); linalg/spd_solver.h stays the general-purpose solver.
 //
 // Status: FactorizationFailed when a pivot is not positive (matrix not SPD or numerically
 // singular); Cancelled when the progress sink asks to stop (checked between supernodes).

@@ -1,4 +1,4 @@
-#include "edit/supernodal_cholesky.h"
+#include "linalg/supernodal_cholesky.h"
 
 #include <algorithm>
 #include <cmath>
