@@ -3,6 +3,7 @@
 #include <map>
 
 #include "linalg/polar.h"
+#include "linalg/rigid_fit.h"
 
 namespace mm {
 
@@ -71,17 +72,14 @@ std::vector<NodeTrack> prop_tracks(const AnimatedCharacter& c, const std::vector
     const int m = static_cast<int>(t.anchor_vertices.size());
     Eigen::MatrixXd X(m, 3);
     for (int i = 0; i < m; ++i) X.row(i) = c.V_rest.row(t.anchor_vertices[i]);
-    const Eigen::RowVector3d cx = X.colwise().mean();
     for (const Eigen::MatrixXd& Vf : frames) {
       Eigen::MatrixXd Y(m, 3);
       for (int i = 0; i < m; ++i) Y.row(i) = Vf.row(t.anchor_vertices[i]);
-      const Eigen::RowVector3d cy = Y.colwise().mean();
-      // Kabsch: R = polar((Y − ȳ)ᵀ (X − x̄)), the rotation of the best rigid fit X → Y.
-      const Eigen::Matrix3d H = (Y.rowwise() - cy).transpose() * (X.rowwise() - cx);
-      const Eigen::Matrix3d R = polar_decomposition(H).R;
+      // The best rigid fit X → Y (Kabsch, linalg/rigid_fit.h).
+      const RigidFit fit = fit_rigid(X, Y);
       Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
-      M.topLeftCorner<3, 3>() = R;
-      M.topRightCorner<3, 1>() = cy.transpose() - R * cx.transpose();
+      M.topLeftCorner<3, 3>() = fit.R;
+      M.topRightCorner<3, 1>() = fit.t;
       t.world.push_back(M * rest[t.node]);
     }
   }

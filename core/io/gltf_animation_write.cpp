@@ -9,26 +9,24 @@
 #include "io/gltf_builder.h"
 #include "io/gltf_document.h"
 #include "io/gltf_serialize.h"
+#include "operators/operators.h"
 
 namespace mm::io {
 
 namespace gltf_anim_write_detail {
 
 // Area-weighted vertex normals where vertices at identical rest positions (glTF seams) share
-// their normal, so seams stay invisible while the morph plays.
+// their normal, so seams stay invisible while the morph plays (empty groups: +Y).
 Eigen::MatrixXd seam_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Eigen::VectorXi& group,
                              int num_groups) {
-  Eigen::MatrixXd acc = Eigen::MatrixXd::Zero(num_groups, 3);
-  for (int f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
-    const Eigen::RowVector3d n = (b - a).cross(c - a).transpose();  // length = 2·area
-    for (int k = 0; k < 3; ++k) acc.row(group[F(f, k)]) += n;
-  }
+  Eigen::MatrixXi G(F.rows(), 3);
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) G(f, k) = group[F(f, k)];
+  const Eigen::MatrixXd acc = grouped_vertex_normals(V, F, G, num_groups);
   Eigen::MatrixXd N(V.rows(), 3);
   for (int v = 0; v < V.rows(); ++v) {
     const Eigen::RowVector3d n = acc.row(group[v]);
-    const double l = n.norm();
-    N.row(v) = l > 0 ? Eigen::RowVector3d(n / l) : Eigen::RowVector3d(0, 1, 0);
+    N.row(v) = n.squaredNorm() > 0 ? n : Eigen::RowVector3d(0, 1, 0);
   }
   return N;
 }

@@ -8,7 +8,7 @@
 #include "io/gltf_builder.h"
 #include "io/gltf_document.h"
 #include "io/gltf_serialize.h"
-#include "io/grouped_normals.h"
+#include "operators/operators.h"
 
 namespace mm::io {
 
@@ -46,7 +46,7 @@ ExportMesh gltf_export_mesh(const Asset& asset, const Eigen::MatrixXd& V_raw_out
   gather("TEXCOORD_0", 2, &out.UV, false);
   gather("COLOR_0", 3, &out.C, false);
   if (out.N.rows() == n && recompute_normals) {
-    const Eigen::MatrixXd R = grouped_normals(V_raw_out, asset.F_raw, asset.F_raw, static_cast<int>(n));
+    const Eigen::MatrixXd R = grouped_vertex_normals(V_raw_out, asset.F_raw, asset.F_raw, static_cast<int>(n));
     for (Eigen::Index r = 0; r < n; ++r)
       if (R.row(r).squaredNorm() > 0) out.N.row(r) = R.row(r);
   }

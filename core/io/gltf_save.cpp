@@ -8,7 +8,7 @@
 #include "io/gltf_accessor.h"
 #include "io/gltf_builder.h"
 #include "io/gltf_document.h"
-#include "io/grouped_normals.h"
+#include "operators/operators.h"
 #include "mesh/mesh.h"
 
 namespace mm::io {
@@ -44,7 +44,7 @@ static Status gltf_write_instance(tinygltf::Model* m, int mesh_index, const Gltf
     const auto n_it = prim.attributes.find("NORMAL");
     if (!opt.recompute_normals || n_it == prim.attributes.end()) continue;
     const Eigen::MatrixXi& F = inst.faces.at(pi);
-    Eigen::MatrixXd N = grouped_normals(L, F, F, static_cast<int>(L.rows()));
+    Eigen::MatrixXd N = grouped_vertex_normals(L, F, F, static_cast<int>(L.rows()));
     Eigen::MatrixXd N_old;
     const bool have_old = read_gltf_accessor(*m, n_it->second, &N_old).ok() && N_old.rows() == L.rows() &&
                           N_old.cols() == 3;

@@ -1,7 +1,6 @@
 # core/io: the Asset loader/saver (asset.h) and one reader/writer pair per format.
 list(APPEND MM_IO_SOURCES
   core/io/asset.cpp
-  core/io/grouped_normals.cpp
   core/io/io_text.cpp
   core/io/json_text.cpp
   core/io/obj.cpp

@@ -6,7 +6,7 @@
 #include <string_view>
 #include <tuple>
 
-#include "io/grouped_normals.h"
+#include "operators/operators.h"
 #include "io/io_text.h"
 #include "io/json_text.h"
 
@@ -154,7 +154,7 @@ Status save_obj_document(const ObjDocument& doc, const Eigen::MatrixXi& F_raw,
   for (size_t k = 0; k < doc.vn_line.size(); ++k) vn_of_line[doc.vn_line[k]] = static_cast<int>(k);
   Eigen::MatrixXd N;
   const bool new_normals = opt.recompute_normals && positions_changed && doc.VN.rows() > 0;
-  if (new_normals) N = grouped_normals(V_raw_new, F_raw, doc.F_vn, static_cast<int>(doc.VN.rows()));
+  if (new_normals) N = grouped_vertex_normals(V_raw_new, F_raw, doc.F_vn, static_cast<int>(doc.VN.rows()));
   const char* eol = doc.crlf ? "\r\n" : "\n";
   out->clear();
   for (size_t i = 0; i < doc.lines.size(); ++i) {
@@ -189,7 +189,7 @@ ExportMesh obj_export_mesh(const ObjDocument& doc, const Eigen::MatrixXi& F_raw,
   }
   Eigen::MatrixXd VN = doc.VN;
   if (has_vn && recompute_normals) {
-    const Eigen::MatrixXd R = grouped_normals(V_raw_new, F_raw, doc.F_vn, static_cast<int>(VN.rows()));
+    const Eigen::MatrixXd R = grouped_vertex_normals(V_raw_new, F_raw, doc.F_vn, static_cast<int>(VN.rows()));
     for (int k = 0; k < VN.rows(); ++k)
       if (R.row(k).squaredNorm() > 0) VN.row(k) = R.row(k);
   }

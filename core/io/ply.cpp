@@ -9,7 +9,7 @@
 #include <cstring>
 #include <string_view>
 
-#include "io/grouped_normals.h"
+#include "operators/operators.h"
 #include "io/io_text.h"
 #include "io/json_text.h"
 
@@ -305,7 +305,7 @@ namespace detail {
 
 // Per-vertex normals of a PLY mesh: every vertex is its own normal group.
 static Eigen::MatrixXd ply_vertex_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
-  return grouped_normals(V, F, F, static_cast<int>(V.rows()));
+  return grouped_vertex_normals(V, F, F, static_cast<int>(V.rows()));
 }
 
 }  // namespace detail
