@@ -49,6 +49,7 @@ const OptionSchema<EditJobOptions>& edit_options() {
 EditJobResult run_edit_job(const EditJobRequest& request, const Progress& progress) {
   EditJobResult r;
   const EditJobFiles& f = request.files;
+  if (!(r.status = io::check_output_path(f.out)).ok()) return r;
   std::vector<uint8_t> spec_bytes;
   if (!(r.status = io::read_file(f.spec, &spec_bytes)).ok()) return r;
   const io::LoadResult lr = io::load_asset(f.in);

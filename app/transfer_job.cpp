@@ -45,6 +45,9 @@ const OptionSchema<PoseTransferOptions>& transfer_options() {
 TransferJobResult run_transfer_job(const TransferJobFiles& files, const PoseTransferOptions& options,
                                    const Progress& progress) {
   TransferJobResult r;
+  if (Status s = io::check_output_path(files.out); !s.ok()) return {s};
+  if (!files.cage_out.empty())
+    if (Status s = io::check_output_path(files.cage_out); !s.ok()) return {s};
   const io::LoadResult ref = io::load_asset(files.reference);
   if (!ref.status.ok()) return {ref.status};
   const io::LoadResult src = io::load_asset(files.source);

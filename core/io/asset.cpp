@@ -1,5 +1,12 @@
 #include "io/asset.h"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdio>
+
+#include "io/json_text.h"
+
 #include <algorithm>
 #include <cassert>
 #include <cctype>
@@ -44,27 +51,64 @@ const char* format_name(Format f) {
 
 Status read_file(const std::string& path, std::vector<uint8_t>* bytes) {
   bytes->clear();
+  // Only regular files: a directory, FIFO or device would be read forever or fail obscurely.
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0)
+    return Status::error(StatusCode::IoError, "cannot open '" + quote_input(path, 200) + "': no such file");
+  if (!S_ISREG(st.st_mode))
+    return Status::error(StatusCode::IoError, "'" + quote_input(path, 200) + "' is not a regular file (" +
+                                                  (S_ISDIR(st.st_mode) ? "a directory" : "a pipe, socket or device") + ")");
+  if (static_cast<uint64_t>(st.st_size) > kMaxInputBytes)
+    return Status::error(StatusCode::Unsupported, "'" + quote_input(path, 200) + "' has " + std::to_string(st.st_size) +
+                                                      " bytes; files over " + std::to_string(kMaxInputBytes >> 20) +
+                                                      " MiB are refused");
   std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::error(StatusCode::IoError, "cannot open '" + path + "' for reading");
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0) return Status::error(StatusCode::IoError, "cannot read '" + path + "' (is it a directory?)");
-  in.seekg(0, std::ios::beg);
-  bytes->resize(static_cast<size_t>(size));
-  if (size > 0 && !in.read(reinterpret_cast<char*>(bytes->data()), size))
-    return Status::error(StatusCode::IoError, "cannot read '" + path + "'");
+  if (!in) return Status::error(StatusCode::IoError, "cannot open '" + quote_input(path, 200) + "' for reading");
+  bytes->resize(static_cast<size_t>(st.st_size));
+  if (st.st_size > 0 && !in.read(reinterpret_cast<char*>(bytes->data()), st.st_size))
+    return Status::error(StatusCode::IoError, "cannot read '" + quote_input(path, 200) + "'");
+  return Status::success();
+}
+
+Status write_file_atomic(const std::string& path, const std::vector<uint8_t>& bytes) {
+  // Written next to the target, then renamed over it: a crash or a full disk leaves the old file
+  // (or nothing), never a truncated one; writing onto the input's own path works.
+  const std::string tmp = path + ".mm-tmp-" + std::to_string(static_cast<long long>(::getpid()));
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) return Status::error(StatusCode::IoError, "cannot open '" + quote_input(path, 200) + "' for writing");
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.close();
+    if (!out) {
+      std::remove(tmp.c_str());
+      return Status::error(StatusCode::IoError, "cannot write '" + quote_input(path, 200) + "' (disk full?)");
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    return Status::error(StatusCode::IoError, "cannot replace '" + quote_input(path, 200) + "'");
+  }
+  return Status::success();
+}
+
+Status check_output_path(const std::string& path) {
+  if (path.empty()) return Status::error(StatusCode::InvalidArgument, "no output path given");
+  const size_t slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  struct stat st;
+  if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
+    return Status::error(StatusCode::IoError, "the output folder '" + quote_input(dir, 200) + "' does not exist");
+  if (::access(dir.c_str(), W_OK) != 0)
+    return Status::error(StatusCode::IoError, "the output folder '" + quote_input(dir, 200) + "' is not writable");
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+    return Status::error(StatusCode::IoError, "the output '" + quote_input(path, 200) + "' is a directory");
   return Status::success();
 }
 
 namespace detail {
 
 static Status asset_write_file(const std::string& path, const std::vector<uint8_t>& bytes) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) return Status::error(StatusCode::IoError, "cannot open '" + path + "' for writing");
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  out.close();
-  if (!out) return Status::error(StatusCode::IoError, "cannot write '" + path + "' (disk full?)");
-  return Status::success();
+  return write_file_atomic(path, bytes);
 }
 
 static std::string asset_parent_dir(const std::string& path) {

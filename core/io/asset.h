@@ -134,6 +134,14 @@ Status save_mesh_to_memory(Format format, const Eigen::MatrixXd& V, const Eigen:
                            std::vector<uint8_t>* bytes, const Eigen::MatrixXd& colors = {});
 
 // Reads a whole file; IoError with the path in the message when it fails.
+// Reads a regular file whole. Directories, FIFOs and devices are refused (IoError), files over
+// kMaxInputBytes before anything is read (Unsupported).
+constexpr uint64_t kMaxInputBytes = uint64_t{2000} << 20;  // 2000 MiB
 Status read_file(const std::string& path, std::vector<uint8_t>* bytes);
+// Writes `bytes` to a temporary file next to `path` and renames it into place.
+Status write_file_atomic(const std::string& path, const std::vector<uint8_t>& bytes);
+// IoError when `path` cannot be written (missing or read-only folder, a directory): checked by
+// the jobs before any long computation.
+Status check_output_path(const std::string& path);
 
 }  // namespace mm::io

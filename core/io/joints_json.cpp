@@ -10,7 +10,7 @@ namespace mm::io {
 
 JointSetResult parse_joints_json(const std::string& text) {
   JointSetResult r;
-  if (Status d = check_json_depth(text, "joints file"); !d.ok()) return {d};
+  if (Status d = check_json_depth(text, "joints file"); !d.ok()) return {d, {}};
   // Parsed without exceptions (the wasm build may have them off): discarded value on error.
   const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
   if (j.is_discarded() || !j.is_object()) {
@@ -42,7 +42,7 @@ JointSetResult parse_joints_json(const std::string& text) {
 
 JointMapResult parse_joint_map_json(const std::string& text) {
   JointMapResult r;
-  if (Status d = check_json_depth(text, "joint map"); !d.ok()) return {d};
+  if (Status d = check_json_depth(text, "joint map"); !d.ok()) return {d, {}};
   const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
   if (j.is_discarded() || !j.is_object()) {
     r.status = Status::error(StatusCode::ParseError,

@@ -27,13 +27,12 @@ OUT with .obj/.ply/.off writes one mesh file per frame (OUT_0000.obj, ...).
 options (app/retarget_job.h):
 )";
 
-bool read_text(const std::string& path, std::string* out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
-  std::stringstream ss;
-  ss << in.rdbuf();
-  *out = ss.str();
-  return true;
+// A JSON input file (joints, joint map) through io::read_file (regular files only, size-limited).
+mm::Status read_text(const std::string& path, std::string* out) {
+  std::vector<uint8_t> bytes;
+  mm::Status s = mm::io::read_file(path, &bytes);
+  if (s.ok()) out->assign(bytes.begin(), bytes.end());
+  return s;
 }
 
 int run_retarget(const std::vector<std::string>& argv) {
@@ -63,12 +62,12 @@ int run_retarget(const std::vector<std::string>& argv) {
     if (!fs.ok()) return cli::report("retarget", Status::error(fs.code, "--frames: " + fs.message));
   }
   std::string joints_json, map_json;
-  if (args.has("target-joints") && !read_text(args.get("target-joints"), &joints_json))
-    return cli::report("retarget", Status::error(StatusCode::IoError, "cannot read " + args.get("target-joints")));
-  if (args.has("joint-map") && !read_text(args.get("joint-map"), &map_json))
-    return cli::report("retarget", Status::error(StatusCode::IoError, "cannot read " + args.get("joint-map")));
+  if (args.has("target-joints") && !(s = read_text(args.get("target-joints"), &joints_json)).ok())
+    return cli::report("retarget", s);
+  if (args.has("joint-map") && !(s = read_text(args.get("joint-map"), &map_json)).ok()) return cli::report("retarget", s);
   if (!(s = cli::check_unused(args)).ok()) return cli::report("retarget", s);
 
+  if (!(s = io::check_output_path(out_path)).ok()) return cli::report("retarget", s);
   io::LoadResult src = io::load_asset(src_path);
   if (!src.status.ok()) return cli::report("retarget", src.status);
   io::LoadResult tgt = io::load_asset(tgt_path);
@@ -90,9 +89,7 @@ int run_retarget(const std::vector<std::string>& argv) {
     std::vector<uint8_t> bytes;
     s = session.write_glb(frames, session.times(), &bytes);
     if (!s.ok()) return cli::report("retarget", s);
-    std::ofstream out(out_path, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    if (!out) return cli::report("retarget", Status::error(StatusCode::IoError, "cannot write " + out_path));
+    if (!(s = io::write_file_atomic(out_path, bytes)).ok()) return cli::report("retarget", s);
   } else {
     const std::string stem = out_path.substr(0, out_path.rfind('.'));
     for (size_t k = 0; k < frames.size(); ++k) {
