@@ -1,0 +1,490 @@
+// The Edit job: move a part of the loaded mesh with a gizmo and let the implicit Laplacian
+// editor (docs/edit.md, worker/ops/edit.js) reshape the rest. A guided step list leads through
+//   1 paint the handle (brush: hold B or turn the brush on; Shift erases)
+//   2 optionally paint the fixed part and / or limit the region of interest, then Start editing
+//   3 drag the gizmo (translate / rotate / scale): previews follow at the worker's pace
+//   4 on release the shape is finalized; save the spec (the CLI's JSON) or export a GLB.
+// Sets live on the welded mesh (what the core edits; lib/vertex-sets.js), the brush paints
+// displayed vertices (view/brush.js) and maps them through toWelded. Drags go through a
+// latest-only pump (lib/latest-only.js): one editDrag in flight, the newest gizmo matrix next.
+// The spec sent to editCreate plus the gizmo matrix is exactly the spec "Save spec" writes
+// (lib/edit-spec.js), so `meshmorph edit --spec` reproduces the page's result.
+// State it owns (window.__meshmorph.state.edit): {step, handle, roi, fixed (counts), session,
+// matrix, drags: {sent, answered, first, last (ms timestamps)}, finalized, spec (sent to
+// editCreate), saved (last saved spec)}. Test hooks (window.__meshmorph.hooks): editGizmoHandle
+// (name) → client {x, y} of a gizmo handle, editPositions() → {raw, welded} current positions.
+import { buildSpec, readSpec } from '../../lib/edit-spec.js';
+import { LatestOnly } from '../../lib/latest-only.js';
+import { grow, members, setFromIndices, shrink, vertexAdjacency, weldedTriangles } from '../../lib/vertex-sets.js';
+import { Brush } from '../../view/brush.js';
+import { EditGizmo } from '../../view/edit-gizmo.js';
+import { selectionColors } from '../../view/selection-colors.js';
+import { download } from '../download.js';
+import { finder, fromHtml } from '../dom.js';
+import { OptionsForm } from '../options-form.js';
+import { StepList } from '../step-list.js';
+
+const identity = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
+const sameMatrix = (a, b) => a && b && a.length === b.length && a.every((v, i) => v === b[i]);
+
+const markup = `
+<section class="edit">
+  <h2>Edit</h2>
+  <div id="edit-steps"></div>
+  <div id="edit-select">
+    <div class="row paint-targets" role="radiogroup" aria-label="Paint">
+      <label class="set-handle"><input type="radio" name="edit-target" value="handle" checked /> Handle</label>
+      <label class="set-fixed"><input type="radio" name="edit-target" value="fixed" /> Fixed</label>
+      <label class="set-roi"><input type="radio" name="edit-target" value="roi" /> Region</label>
+    </div>
+    <div class="row">
+      <button id="edit-brush" type="button" aria-pressed="false" title="Paint with the brush (or hold B); Shift erases">Brush</button>
+      <label class="slider row">size <input type="range" id="edit-radius" min="4" max="80" value="24" /></label>
+    </div>
+    <div class="row">
+      <button id="edit-grow" type="button" title="Add the neighbours of the painted set (1 ring)">Grow</button>
+      <button id="edit-shrink" type="button" title="Remove the border of the painted set (1 ring)">Shrink</button>
+      <button id="edit-clear" type="button" title="Empty the painted set">Clear</button>
+    </div>
+    <p id="edit-counts" class="hint"></p>
+    <button id="edit-start" type="button" data-idle>Start editing</button>
+  </div>
+  <div id="edit-drag" hidden>
+    <div class="row" role="radiogroup" aria-label="Gizmo">
+      <label><input type="radio" name="edit-mode" value="translate" checked /> Move (W)</label>
+      <label><input type="radio" name="edit-mode" value="rotate" /> Rotate (E)</label>
+      <label><input type="radio" name="edit-mode" value="scale" /> Scale (R)</label>
+    </div>
+    <label class="row">Details
+      <select id="edit-features" data-idle title="keep: details keep their size (Eq. 9); scale: they follow the handle's scaling (Eq. 10)">
+        <option value="keep">keep their size</option>
+        <option value="scale">scale with the handle</option>
+      </select>
+    </label>
+    <div class="row">
+      <button id="edit-undo" type="button" data-idle title="Ctrl+Z">Undo</button>
+      <button id="edit-redo" type="button" data-idle title="Ctrl+Y">Redo</button>
+      <button id="edit-reset" type="button" data-idle title="Put the handle back where it was">Reset</button>
+      <button id="edit-stop" type="button" data-idle title="End the session and change the selection">Back to selection</button>
+    </div>
+  </div>
+  <div class="row">
+    <button id="edit-save" type="button" data-idle title="The edit as a JSON spec for meshmorph edit --spec">Save spec</button>
+    <label class="button file" title="Open a spec this page saved">Load spec…
+      <input type="file" id="edit-load" accept=".json,application/json" data-idle />
+    </label>
+    <button id="edit-export" type="button" data-idle>Export GLB</button>
+  </div>
+  <div id="edit-options"></div>
+</section>`;
+
+export const panel = {
+  id: 'edit',
+  title: 'Edit',
+  create(app) {
+    const { state, viewer, client } = app;
+    const root = fromHtml(markup);
+    const $ = finder(root);
+    const edit = {
+      step: 0, handle: 0, roi: 0, fixed: 0, session: false, matrix: identity,
+      drags: { sent: 0, answered: 0, first: 0, last: 0 }, finalized: 0, spec: null, saved: null,
+    };
+    state.edit = edit;
+
+    const steps = new StepList([
+      { title: 'Select the handle' },
+      { title: 'Fixed part / region (optional)' },
+      { title: 'Drag the gizmo' },
+      { title: 'Save or export' },
+    ]);
+    $('edit-steps').append(steps.element);
+
+    // ---- the mesh as the panel sees it
+    let topology = null;     // {count, toWelded, triangles, adjacency (lazy), restRaw, restWelded}
+    let sets = null;         // {handle, roi, fixed}: Uint8Array per welded vertex
+    let welded = null;       // current welded positions (Float32Array #W·3) after a drag/finalize
+    let history = [identity]; // gizmo matrices; history[at] is the current one
+    let at = 0;
+    let lastDragged = null;  // the matrix of the last editDrag the worker answered
+    let form = null;         // OptionsForm, once the schema arrived
+    let visible = false;     // the Edit job is shown
+
+    const brush = new Brush(viewer);
+    const gizmo = new EditGizmo(viewer, {
+      onChange: (matrix) => { if (edit.session) pump.push(matrix); },
+      onRelease: (matrix) => { if (edit.session) commit(matrix); },
+    });
+
+    function newMesh(mesh) {
+      const geometry = viewer.geometry;
+      const restRaw = geometry.getAttribute('position').array.slice();
+      const count = mesh.weldedVertices;
+      const restWelded = new Float64Array(count * 3);
+      for (let r = 0; r < mesh.toWelded.length; ++r) {
+        const w = mesh.toWelded[r];
+        restWelded.set(restRaw.subarray(3 * r, 3 * r + 3), 3 * w);
+      }
+      topology = { count, toWelded: mesh.toWelded, triangles: weldedTriangles(geometry.index.array, mesh.toWelded), adjacency: null, restRaw, restWelded };
+      sets = { handle: new Uint8Array(count), roi: new Uint8Array(count), fixed: new Uint8Array(count) };
+      welded = null;
+      endSession({ restore: false });
+      refresh();
+    }
+
+    const adjacency = () => (topology.adjacency ??= vertexAdjacency(topology.triangles, topology.count));
+    const target = () => root.querySelector('input[name="edit-target"]:checked').value;
+
+    // ---- showing the state
+
+    function showColors() {
+      if (visible && sets) viewer.setColors(selectionColors(sets, topology.toWelded));
+    }
+
+    function refresh() {
+      const count = (s) => (sets ? members(s).length : 0);
+      edit.handle = count(sets?.handle);
+      edit.roi = count(sets?.roi);
+      edit.fixed = count(sets?.fixed);
+      $('edit-counts').textContent = sets
+        ? `handle ${edit.handle} · fixed ${edit.fixed} · region ${edit.roi || 'whole part (default)'} (welded vertices)`
+        : 'Load a mesh first (Mesh tab).';
+      $('edit-select').hidden = edit.session;
+      $('edit-drag').hidden = !edit.session;
+      $('edit-brush').setAttribute('aria-pressed', String(brushOn));
+      if (!state.mesh) {
+        edit.step = 0;
+        steps.set(0, 'Load a mesh in the Mesh tab.');
+      } else if (!edit.session && !edit.handle) {
+        edit.step = 0;
+        steps.set(0, 'Turn on the Brush (or hold B) and paint the part you want to move.');
+      } else if (!edit.session) {
+        edit.step = 1;
+        steps.set(1, 'Optionally paint the Fixed part (or a Region), then press Start editing.');
+      } else if (edit.finalized === 0) {
+        edit.step = 2;
+        steps.set(2, 'Drag an arrow, ring or box of the gizmo (W / E / R: move, rotate, scale).');
+      } else {
+        edit.step = 3;
+        steps.set(3, 'Save spec or Export GLB — or keep dragging; Undo goes back.');
+      }
+    }
+
+    // ---- the brush
+
+    let brushOn = false;   // the Brush button
+    let keyHeld = false;   // B held
+    let painting = false;
+    let pointer = null;    // last client position over the canvas
+    const brushActive = () => visible && !edit.session && Boolean(sets) && (brushOn || keyHeld);
+
+    function updateBrush() {
+      const active = brushActive();
+      viewer.controls.enabled = !active && !gizmo.dragging;
+      if (active && pointer) brush.showCursor(pointer.x, pointer.y, { erase: pointer.shift });
+      else brush.showCursor(null);
+      refresh();
+    }
+
+    function paintAt(x, y, erase) {
+      const name = target();
+      const set = sets[name];
+      let changed = false;
+      for (const r of brush.verticesAt(x, y)) {
+        const w = topology.toWelded[r];
+        if (erase) {
+          changed ||= set[w] === 1;
+          set[w] = 0;
+          continue;
+        }
+        changed ||= set[w] === 0;
+        set[w] = 1;
+        if (name === 'handle') sets.fixed[w] = 0; // a vertex is moved or held, not both
+        if (name === 'fixed') sets.handle[w] = 0;
+      }
+      if (changed) {
+        showColors();
+        refresh();
+      }
+    }
+
+    const canvas = viewer.renderer.domElement;
+    canvas.addEventListener('pointerdown', (e) => {
+      if (!brushActive() || e.button !== 0) return;
+      painting = true;
+      canvas.setPointerCapture(e.pointerId);
+      pointer = { x: e.clientX, y: e.clientY, shift: e.shiftKey };
+      paintAt(e.clientX, e.clientY, e.shiftKey);
+    });
+    canvas.addEventListener('pointermove', (e) => {
+      pointer = { x: e.clientX, y: e.clientY, shift: e.shiftKey };
+      if (!brushActive()) return;
+      brush.showCursor(e.clientX, e.clientY, { erase: e.shiftKey });
+      if (painting) paintAt(e.clientX, e.clientY, e.shiftKey);
+    });
+    const stopPainting = () => { painting = false; };
+    canvas.addEventListener('pointerup', stopPainting);
+    canvas.addEventListener('pointercancel', stopPainting);
+    canvas.addEventListener('pointerleave', () => {
+      pointer = null;
+      brush.showCursor(null);
+    });
+
+    const typing = (e) => e.target instanceof HTMLElement && /^(INPUT|SELECT|TEXTAREA)$/.test(e.target.tagName) && e.target.type !== 'radio';
+    window.addEventListener('keydown', (e) => {
+      if (!visible || typing(e)) return;
+      const key = e.key.toLowerCase();
+      if (key === 'b' && !e.repeat && !edit.session) {
+        keyHeld = true;
+        updateBrush();
+      } else if (edit.session && !e.ctrlKey && !e.metaKey && 'wer'.includes(key) && key.length === 1) {
+        setMode({ w: 'translate', e: 'rotate', r: 'scale' }[key]);
+      } else if (edit.session && (e.ctrlKey || e.metaKey) && key === 'z') {
+        e.preventDefault();
+        if (e.shiftKey) redo(); else undo();
+      } else if (edit.session && (e.ctrlKey || e.metaKey) && key === 'y') {
+        e.preventDefault();
+        redo();
+      }
+    });
+    window.addEventListener('keyup', (e) => {
+      if (e.key.toLowerCase() === 'b' && keyHeld) {
+        keyHeld = false;
+        painting = false;
+        updateBrush();
+      }
+    });
+
+    $('edit-brush').addEventListener('click', () => {
+      brushOn = !brushOn;
+      updateBrush();
+    });
+    $('edit-radius').addEventListener('input', () => {
+      brush.setRadius(Number($('edit-radius').value));
+      if (brushActive() && pointer) brush.showCursor(pointer.x, pointer.y);
+    });
+    brush.setRadius(Number($('edit-radius').value));
+
+    function changeSet(fn) {
+      if (!sets) return;
+      fn(sets[target()]);
+      if (target() === 'handle') for (let w = 0; w < topology.count; ++w) if (sets.handle[w]) sets.fixed[w] = 0;
+      if (target() === 'fixed') for (let w = 0; w < topology.count; ++w) if (sets.fixed[w]) sets.handle[w] = 0;
+      showColors();
+      refresh();
+    }
+    $('edit-grow').addEventListener('click', () => changeSet((s) => grow(s, adjacency())));
+    $('edit-shrink').addEventListener('click', () => changeSet((s) => shrink(s, adjacency())));
+    $('edit-clear').addEventListener('click', () => changeSet((s) => s.fill(0)));
+
+    // ---- the session
+
+    const features = () => $('edit-features').value;
+    const currentSpec = (matrix) => buildSpec({
+      handle: members(sets.handle), roi: members(sets.roi), fixed: members(sets.fixed),
+      matrix, features: features(), options: form ? form.values() : {},
+    });
+
+    function show(result) {
+      welded = result.buffers.positions;
+      viewer.setPositions(result.buffers.rawPositions);
+    }
+
+    const pump = new LatestOnly(
+      (matrix) => {
+        edit.drags.sent += 1;
+        if (!edit.drags.first) edit.drags.first = performance.now();
+        return client.run('editDrag', { transforms: [{ matrix }] }).promise;
+      },
+      {
+        onAnswer(result, matrix) {
+          edit.drags.answered += 1;
+          edit.drags.last = performance.now();
+          lastDragged = matrix;
+          show(result);
+        },
+        onError: (e) => app.showError(e),
+      },
+    );
+
+    // Brings the mesh to the gizmo matrix and finalizes it (release, undo, redo, reset, mode).
+    async function settle(matrix) {
+      await pump.idle();
+      if (!sameMatrix(lastDragged, matrix)) {
+        const dragged = await app.runOp('Moving the handle', 'editDrag', { transforms: [{ matrix }] });
+        if (!dragged) return false;
+        lastDragged = matrix;
+      }
+      const result = await app.runOp('Finalizing', 'editFinalize', { mode: features() });
+      if (!result) return false;
+      show(result);
+      edit.matrix = matrix;
+      edit.finalized += 1;
+      refresh();
+      return true;
+    }
+
+    async function commit(matrix) {
+      if (sameMatrix(history[at], matrix) && edit.finalized > 0) return; // a click, no move
+      history = history.slice(0, at + 1);
+      history.push(matrix);
+      at = history.length - 1;
+      await settle(matrix);
+    }
+
+    async function goTo(index) {
+      if (!edit.session || index < 0 || index >= history.length || gizmo.dragging) return;
+      at = index;
+      gizmo.setMatrix(history[at]);
+      await settle(history[at]);
+    }
+    const undo = () => goTo(at - 1);
+    const redo = () => goTo(at + 1);
+
+    function setMode(mode) {
+      gizmo.setMode(mode);
+      const radio = root.querySelector(`input[name="edit-mode"][value="${mode}"]`);
+      if (radio) radio.checked = true;
+    }
+
+    async function startSession(matrix = null) {
+      if (!sets || !members(sets.handle).length) {
+        app.showError({ code: 'InvalidArgument', message: 'paint a handle first (step 1): the edit needs at least one handle vertex' });
+        return false;
+      }
+      const spec = currentSpec(null);
+      const result = await app.runOp('Preparing the edit', 'editCreate', { spec });
+      if (!result) return false;
+      edit.spec = spec;
+      edit.session = true;
+      edit.finalized = 0;
+      edit.matrix = identity;
+      edit.drags = { sent: 0, answered: 0, first: 0, last: 0 };
+      lastDragged = null;
+      history = [identity];
+      at = 0;
+      brushOn = false;
+      keyHeld = false;
+      // The gizmo sits at the centroid of the handle's rest positions (the spec's default pivot).
+      const handle = members(sets.handle);
+      const c = [0, 0, 0];
+      for (const w of handle) for (let k = 0; k < 3; ++k) c[k] += topology.restWelded[3 * w + k] / handle.length;
+      gizmo.attach(c);
+      updateBrush();
+      app.setStatus(`editing: ${result.info.handles[0]} handle vertices, ${result.info.stats.free_vertices} free · prepared in ${result.info.milliseconds} ms`);
+      if (matrix) {
+        gizmo.setMatrix(matrix);
+        await commit(matrix);
+      }
+      return true;
+    }
+
+    function endSession({ restore = true } = {}) {
+      if (edit.session) client.run('editDispose', {}).promise.catch(() => {});
+      edit.session = false;
+      edit.finalized = 0;
+      edit.matrix = identity;
+      lastDragged = null;
+      history = [identity];
+      at = 0;
+      gizmo.detach();
+      if (restore && topology) viewer.setPositions(topology.restRaw.slice());
+      welded = null;
+    }
+
+    $('edit-start').addEventListener('click', () => startSession());
+    $('edit-stop').addEventListener('click', () => {
+      endSession();
+      refresh();
+      updateBrush();
+    });
+    $('edit-undo').addEventListener('click', undo);
+    $('edit-redo').addEventListener('click', redo);
+    $('edit-reset').addEventListener('click', () => {
+      if (!edit.session) return;
+      gizmo.setMatrix(identity);
+      commit(identity);
+    });
+    $('edit-features').addEventListener('change', () => { if (edit.session) settle(history[at]); });
+    for (const radio of root.querySelectorAll('input[name="edit-mode"]')) radio.addEventListener('change', () => setMode(radio.value));
+
+    // ---- save, load, export
+
+    $('edit-save').addEventListener('click', () => {
+      if (!sets || !members(sets.handle).length) {
+        app.showError({ code: 'InvalidArgument', message: 'paint a handle first: a spec needs at least one handle vertex' });
+        return;
+      }
+      const spec = currentSpec(edit.session ? history[at] : null);
+      edit.saved = spec;
+      const stem = state.mesh.name.replace(/\.[^.]*$/, '');
+      download(new TextEncoder().encode(`${JSON.stringify(spec, null, 1)}\n`), `${stem}.edit.json`, 'application/json');
+    });
+
+    $('edit-load').addEventListener('change', async () => {
+      const file = $('edit-load').files[0];
+      $('edit-load').value = '';
+      if (!file || !topology) return;
+      let spec;
+      try {
+        spec = readSpec(JSON.parse(await file.text()));
+        sets = {
+          handle: setFromIndices(spec.handle, topology.count),
+          roi: setFromIndices(spec.roi, topology.count),
+          fixed: setFromIndices(spec.fixed, topology.count),
+        };
+      } catch (e) {
+        app.showError(e instanceof SyntaxError ? { code: 'ParseError', message: `${file.name}: ${e.message}` } : e);
+        return;
+      }
+      $('edit-features').value = spec.features;
+      form?.setValues(spec.options);
+      endSession();
+      showColors();
+      refresh();
+      await startSession(spec.matrix);
+    });
+
+    $('edit-export').addEventListener('click', async () => {
+      if (!state.mesh) return;
+      const buffers = welded ? { positions: welded } : {};
+      const result = await app.runOp('Exporting GLB', 'export', { format: 'glb' }, buffers);
+      if (!result) return;
+      download(result.buffers.bytes, result.info.fileName.replace(/\.glb$/, '-edited.glb'), 'model/gltf-binary');
+    });
+
+    // ---- wiring
+
+    app.on('ready', async () => {
+      try {
+        const result = await client.run('optionSchema', { job: 'edit' }).promise;
+        form = new OptionsForm(result.info, { title: 'Options (used at Start editing)' });
+        $('edit-options').append(form.element);
+      } catch (e) {
+        app.showError(e);
+      }
+      refresh();
+    });
+    app.on('mesh', (mesh) => newMesh(mesh));
+    app.on('job', (job) => {
+      const was = visible;
+      visible = job === 'edit';
+      if (visible) {
+        showColors();
+        if (edit.session) gizmo.show();
+      } else if (was) {
+        viewer.setColors(null);
+        gizmo.hide();
+        keyHeld = false;
+        brushOn = false;
+      }
+      updateBrush();
+    });
+    app.hooks.editGizmoHandle = (name) => (edit.session ? gizmo.handleOnScreen(name) : null);
+    app.hooks.editPositions = () => ({
+      raw: Array.from(viewer.geometry.getAttribute('position').array),
+      welded: welded ? Array.from(welded) : null,
+    });
+    refresh();
+    return root;
+  },
+};
