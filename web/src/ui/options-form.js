@@ -1,4 +1,4 @@
-// An options form generated from a job's options schema (the optionSchema op: [{name, kind,
+// An options form generated from a job's options schema (the optionSchema op's options: [{name, kind,
 // default, min, max, choices, help}], kinds integer, number, boolean, choice, text): one control
 // per option with its help as a line under it and as a tooltip, inside a collapsible
 // <details>. values() gives only the options the user changed from their defaults, under the

@@ -10,7 +10,7 @@
 // The spec sent to editCreate plus the gizmo matrix is exactly the spec "Save spec" writes
 // (lib/edit-spec.js), so `meshmorph edit --spec` reproduces the page's result.
 // State it owns (window.__meshmorph.state.edit): {step, handle, roi, fixed (counts), session,
-// matrix, drags: {sent, answered, first, last (ms timestamps)}, finalized, spec (sent to
+// matrix, drags: {sent, answered, first, last (ms timestamps), roundTripMs (sum)}, finalized, spec (sent to
 // editCreate), saved (last saved spec)}. Test hooks (window.__meshmorph.hooks): editGizmoHandle
 // (name) → client {x, y} of a gizmo handle, editPositions() → {raw, welded} current positions.
 import { buildSpec, readSpec } from '../../lib/edit-spec.js';
@@ -87,7 +87,7 @@ export const panel = {
     const $ = finder(root);
     const edit = {
       step: 0, handle: 0, roi: 0, fixed: 0, session: false, matrix: identity,
-      drags: { sent: 0, answered: 0, first: 0, last: 0 }, finalized: 0, spec: null, saved: null,
+      drags: { sent: 0, answered: 0, first: 0, last: 0, roundTripMs: 0 }, finalized: 0, spec: null, saved: null,
     };
     state.edit = edit;
 
@@ -279,10 +279,16 @@ export const panel = {
     // ---- the session
 
     const features = () => $('edit-features').value;
-    const currentSpec = (matrix) => buildSpec({
-      handle: members(sets.handle), roi: members(sets.roi), fixed: members(sets.fixed),
-      matrix, features: features(), options: form ? form.values() : {},
-    });
+    // The spec of the current selection and options; in a session, of the session's selection
+    // and options (changes wait for the next Start editing) with the current features mode.
+    const currentSpec = (matrix) => {
+      const base = edit.session ? readSpec(edit.spec) : {
+        handle: members(sets.handle), roi: members(sets.roi), fixed: members(sets.fixed), options: form ? form.values() : {},
+      };
+      return buildSpec({ ...base, matrix, features: features() });
+    };
+    // The CLI finalizes only with method "implicit" (the naive baseline has no second step).
+    const finalizes = () => (edit.spec?.options?.method ?? 'implicit') === 'implicit';
 
     function show(result) {
       welded = result.buffers.positions;
@@ -292,8 +298,12 @@ export const panel = {
     const pump = new LatestOnly(
       (matrix) => {
         edit.drags.sent += 1;
-        if (!edit.drags.first) edit.drags.first = performance.now();
-        return client.run('editDrag', { transforms: [{ matrix }] }).promise;
+        const sentAt = performance.now();
+        if (!edit.drags.first) edit.drags.first = sentAt;
+        return client.run('editDrag', { transforms: [{ matrix }] }).promise.then((result) => {
+          edit.drags.roundTripMs += performance.now() - sentAt;
+          return result;
+        });
       },
       {
         onAnswer(result, matrix) {
@@ -314,9 +324,11 @@ export const panel = {
         if (!dragged) return false;
         lastDragged = matrix;
       }
-      const result = await app.runOp('Finalizing', 'editFinalize', { mode: features() });
-      if (!result) return false;
-      show(result);
+      if (finalizes()) {
+        const result = await app.runOp('Finalizing', 'editFinalize', { mode: features() });
+        if (!result) return false;
+        show(result);
+      }
       edit.matrix = matrix;
       edit.finalized += 1;
       refresh();
@@ -351,6 +363,7 @@ export const panel = {
         app.showError({ code: 'InvalidArgument', message: 'paint a handle first (step 1): the edit needs at least one handle vertex' });
         return false;
       }
+      endSession({ restore: true });
       const spec = currentSpec(null);
       const result = await app.runOp('Preparing the edit', 'editCreate', { spec });
       if (!result) return false;
@@ -358,7 +371,7 @@ export const panel = {
       edit.session = true;
       edit.finalized = 0;
       edit.matrix = identity;
-      edit.drags = { sent: 0, answered: 0, first: 0, last: 0 };
+      edit.drags = { sent: 0, answered: 0, first: 0, last: 0, roundTripMs: 0 };
       lastDragged = null;
       history = [identity];
       at = 0;
@@ -457,7 +470,10 @@ export const panel = {
     app.on('ready', async () => {
       try {
         const result = await client.run('optionSchema', { job: 'edit' }).promise;
-        form = new OptionsForm(result.info, { title: 'Options (used at Start editing)' });
+        // "features" has its own control (Details), applied at every finalize.
+        // The op answers {job, summary, options: [...]} (wasm/bind_app.cpp).
+        const options = Array.isArray(result.info) ? result.info : result.info.options;
+        form = new OptionsForm(options.filter((o) => o.name !== 'features'), { title: 'Options (used at Start editing)' });
         $('edit-options').append(form.element);
       } catch (e) {
         app.showError(e);
