@@ -447,6 +447,7 @@ it('edit: brush a handle and a fixed part, drag the gizmo, finalize; the saved s
   check((await page.getAttribute('#opt-coherence_rings', 'min')) === '1', 'coherence_rings has no range');
   check(((await page.locator('.option label').first().getAttribute('title')) || '').length > 10, 'options have no help tooltip');
   await page.fill('#opt-finalize_refinements', '2');
+  await shot(page, '11-edit-0-options');
   await page.click('details.options summary');
 
   // 1: the handle — the brush on the outermost visible vertex of the hand on the right (real

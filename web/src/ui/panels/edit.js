@@ -103,6 +103,7 @@ export const panel = {
     let topology = null;     // {count, toWelded, triangles, adjacency (lazy), restRaw, restWelded}
     let sets = null;         // {handle, roi, fixed}: Uint8Array per welded vertex
     let welded = null;       // current welded positions (Float32Array #W·3) after a drag/finalize
+    let shown = null;        // the same in the raw layout (what the Edit job shows)
     let history = [identity]; // gizmo matrices; history[at] is the current one
     let at = 0;
     let lastDragged = null;  // the matrix of the last editDrag the worker answered
@@ -292,7 +293,8 @@ export const panel = {
 
     function show(result) {
       welded = result.buffers.positions;
-      viewer.setPositions(result.buffers.rawPositions);
+      shown = result.buffers.rawPositions;
+      if (visible) viewer.setPositions(shown);
     }
 
     const pump = new LatestOnly(
@@ -400,8 +402,9 @@ export const panel = {
       history = [identity];
       at = 0;
       gizmo.detach();
-      if (restore && topology) viewer.setPositions(topology.restRaw.slice());
+      if (restore && topology && shown) viewer.setPositions(topology.restRaw.slice());
       welded = null;
+      shown = null;
     }
 
     $('edit-start').addEventListener('click', () => startSession());
@@ -484,11 +487,14 @@ export const panel = {
     app.on('job', (job) => {
       const was = visible;
       visible = job === 'edit';
+      // Other jobs work on the loaded mesh, so they show it; the edit comes back with the job.
       if (visible) {
         showColors();
+        if (shown) viewer.setPositions(shown.slice());
         if (edit.session) gizmo.show();
       } else if (was) {
         viewer.setColors(null);
+        if (shown) viewer.setPositions(topology.restRaw.slice());
         gizmo.hide();
         keyHeld = false;
         brushOn = false;
