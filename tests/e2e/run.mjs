@@ -503,8 +503,14 @@ it('edit: brush a handle and a fixed part, drag the gizmo, finalize; the saved s
   await waitFinalized(page, 1);
   edit = await editState(page);
   const seconds = (edit.drags.last - edit.drags.first) / 1000;
+  const frameMs = await page.evaluate(async () => {
+    const started = performance.now();
+    for (let i = 0; i < 5; ++i) await window.__meshmorph.nextFrame();
+    return (performance.now() - started) / 5;
+  });
   console.log(`     drag: 40 mouse moves in ${dragMs} ms → ${edit.drags.sent} editDrag requests, ${edit.drags.answered} answered, `
-    + `${(edit.drags.answered / seconds).toFixed(1)} per second, mean round trip ${(edit.drags.roundTripMs / edit.drags.answered).toFixed(1)} ms`);
+    + `${(edit.drags.answered / seconds).toFixed(1)} per second; mean worker round trip ${(edit.drags.roundTripMs / edit.drags.answered).toFixed(1)} ms, `
+    + `geometry update ${(edit.drags.applyMs / edit.drags.answered).toFixed(1)} ms, a rendered frame ${frameMs.toFixed(0)} ms`);
   check(edit.drags.sent >= 5 && edit.drags.answered === edit.drags.sent, `drag requests ${JSON.stringify(edit.drags)}`);
   check(edit.step === 3, `step after the drag: ${edit.step}`);
   const m = edit.matrix;
@@ -569,6 +575,8 @@ it('edit: brush a handle and a fixed part, drag the gizmo, finalize; the saved s
   await glb.saveAs(glbFile);
   const bytes = fs.readFileSync(glbFile);
   check(bytes.subarray(0, 4).toString('latin1') === 'glTF' && bytes.readUInt32LE(8) === bytes.length, `bad GLB ${glb.suggestedFilename()}`);
+  const report = await (await import('gltf-validator')).validateBytes(new Uint8Array(bytes));
+  check(report.issues.numErrors === 0, `edited GLB: glTF-Validator: ${JSON.stringify(report.issues.messages.slice(0, 3))}`);
 
   // Loading the saved spec starts a session and gives the same shape again.
   await page.click('#edit-stop');

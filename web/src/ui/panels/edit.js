@@ -10,7 +10,8 @@
 // The spec sent to editCreate plus the gizmo matrix is exactly the spec "Save spec" writes
 // (lib/edit-spec.js), so `meshmorph edit --spec` reproduces the page's result.
 // State it owns (window.__meshmorph.state.edit): {step, handle, roi, fixed (counts), session,
-// matrix, drags: {sent, answered, first, last (ms timestamps), roundTripMs (sum)}, finalized, spec (sent to
+// matrix, drags: {sent, answered, first, last (ms timestamps), roundTripMs, applyMs (sums: worker round
+// trip, updating the geometry)}, finalized, spec (sent to
 // editCreate), saved (last saved spec)}. Test hooks (window.__meshmorph.hooks): editGizmoHandle
 // (name) → client {x, y} of a gizmo handle, editPositions() → {raw, welded} current positions.
 import { buildSpec, readSpec } from '../../lib/edit-spec.js';
@@ -87,7 +88,7 @@ export const panel = {
     const $ = finder(root);
     const edit = {
       step: 0, handle: 0, roi: 0, fixed: 0, session: false, matrix: identity,
-      drags: { sent: 0, answered: 0, first: 0, last: 0, roundTripMs: 0 }, finalized: 0, spec: null, saved: null,
+      drags: { sent: 0, answered: 0, first: 0, last: 0, roundTripMs: 0, applyMs: 0 }, finalized: 0, spec: null, saved: null,
     };
     state.edit = edit;
 
@@ -309,10 +310,12 @@ export const panel = {
       },
       {
         onAnswer(result, matrix) {
+          const started = performance.now();
           edit.drags.answered += 1;
-          edit.drags.last = performance.now();
           lastDragged = matrix;
           show(result);
+          edit.drags.last = performance.now();
+          edit.drags.applyMs += edit.drags.last - started;
         },
         onError: (e) => app.showError(e),
       },
@@ -373,7 +376,7 @@ export const panel = {
       edit.session = true;
       edit.finalized = 0;
       edit.matrix = identity;
-      edit.drags = { sent: 0, answered: 0, first: 0, last: 0, roundTripMs: 0 };
+      edit.drags = { sent: 0, answered: 0, first: 0, last: 0, roundTripMs: 0, applyMs: 0 };
       lastDragged = null;
       history = [identity];
       at = 0;
