@@ -427,7 +427,7 @@ async function waitFinalized(page, n) {
   check(!error, `edit error: ${JSON.stringify(error)}`);
 }
 
-it('edit: brush a handle and a fixed part, drag the gizmo, finalize; the saved spec gives the CLI the same mesh', async ({ page }) => {
+it('edit: brush two handles and a fixed part, drag the gizmo, finalize; the saved spec gives the CLI the same mesh', async ({ page }) => {
   const restFile = path.join(repoDir, 'data/edit/armadillo.ply');
   const rest = readPlyVertices(fs.readFileSync(restFile));
   const diagonal = bboxDiagonal(rest);
@@ -463,6 +463,15 @@ it('edit: brush a handle and a fixed part, drag the gizmo, finalize; the saved s
   await page.click('#edit-grow');
   edit = await editState(page);
   check(edit.handle > painted && edit.step === 1, `grow: ${painted} → ${edit.handle} (step ${edit.step})`);
+  // A second handle on the other hand: it stays where it is while the first one moves.
+  await page.click('#edit-new-handle');
+  const otherHand = await visibleVertex(page, '-x');
+  check(otherHand, 'no visible vertex on the left of the mesh');
+  await stroke(page, otherHand);
+  await page.click('#edit-grow');
+  edit = await editState(page);
+  check(edit.handles.length === 2 && edit.handles[1] > 0 && edit.active === 1, `second handle: ${JSON.stringify(edit.handles)}`);
+  await page.selectOption('#edit-handle', '0');
   // 2: the fixed part — the lowest visible vertices of both feet.
   await page.check('input[name="edit-target"][value="fixed"]');
   for (const key of ['-y - 0.5 * x', '-y + 0.5 * x']) {
@@ -513,8 +522,9 @@ it('edit: brush a handle and a fixed part, drag the gizmo, finalize; the saved s
     + `geometry update ${(edit.drags.applyMs / edit.drags.answered).toFixed(1)} ms, a rendered frame ${frameMs.toFixed(0)} ms`);
   check(edit.drags.sent >= 5 && edit.drags.answered === edit.drags.sent, `drag requests ${JSON.stringify(edit.drags)}`);
   check(edit.step === 3, `step after the drag: ${edit.step}`);
-  const m = edit.matrix;
+  const m = edit.matrices[0];
   const lift = Math.hypot(m[12], m[13], m[14]);
+  check(edit.matrices.length === 2 && edit.matrices[1].every((v, i) => v === [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1][i]), `the second handle moved: ${JSON.stringify(edit.matrices)}`);
   check(m[13] > 0.05 * diagonal, `the gizmo moved the handle by ${JSON.stringify(m.slice(12, 15))} (diagonal ${diagonal})`);
   await nextFrame(page);
   await shot(page, '11-edit-4-finalized');
@@ -523,12 +533,13 @@ it('edit: brush a handle and a fixed part, drag the gizmo, finalize; the saved s
   const { raw, welded } = await page.evaluate(() => window.__meshmorph.hooks.editPositions());
   const toWelded = await page.evaluate(() => Array.from(window.__meshmorph.state.mesh.toWelded));
   check(welded && welded.length === rest.length, 'no welded positions after finalize');
-  const handle = edit.spec.handles[0].select;
   let handleError = 0;
-  for (const w of handle) {
-    const target = transformPoint(m, rest[3 * w], rest[3 * w + 1], rest[3 * w + 2]);
-    handleError = Math.max(handleError, Math.hypot(...target.map((t, k) => t - welded[3 * w + k])));
-  }
+  edit.spec.handles.forEach(({ select }, h) => {
+    for (const w of select) {
+      const target = transformPoint(edit.matrices[h], rest[3 * w], rest[3 * w + 1], rest[3 * w + 2]);
+      handleError = Math.max(handleError, Math.hypot(...target.map((t, k) => t - welded[3 * w + k])));
+    }
+  });
   check(handleError < 1e-5 * diagonal, `handle vertices are ${handleError / diagonal}·diag from their targets`);
   let fixedError = 0;
   for (const w of edit.spec.fixed) fixedError = Math.max(fixedError, Math.hypot(...[0, 1, 2].map((k) => rest[3 * w + k] - welded[3 * w + k])));
@@ -546,8 +557,8 @@ it('edit: brush a handle and a fixed part, drag the gizmo, finalize; the saved s
   const specFile = path.join(shotDir, specDownload.suggestedFilename());
   await specDownload.saveAs(specFile);
   const spec = JSON.parse(fs.readFileSync(specFile, 'utf8'));
-  check(JSON.stringify(spec.handles[0].matrix) === JSON.stringify(m), 'the saved matrix is not the one the page sent');
-  check(JSON.stringify({ ...spec, handles: [{ select: spec.handles[0].select }] }) === JSON.stringify(edit.spec), 'the saved spec differs from the one the page created the session with');
+  check(JSON.stringify(spec.handles.map((h) => h.matrix)) === JSON.stringify(edit.matrices), 'the saved matrices are not the ones the page sent');
+  check(JSON.stringify({ ...spec, handles: spec.handles.map((h) => ({ select: h.select })) }) === JSON.stringify(edit.spec), 'the saved spec differs from the one the page created the session with');
   check(fs.existsSync(cliPath), `the CLI is missing: ${cliPath} (set MM_CLI)`);
   const cliOut = path.join(shotDir, 'armadillo-edit-cli.ply');
   const run = spawnSync(cliPath, ['edit', restFile, '--spec', specFile, '--out', cliOut, '--quiet'], { encoding: 'utf8', timeout: 120000 });

@@ -3,7 +3,7 @@
 // drag pump (one request in flight, the newest value next, never a queue of stale ones).
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
-import { buildSpec, readSpec } from '../../web/src/lib/edit-spec.js';
+import { buildSpec, identity, readSpec } from '../../web/src/lib/edit-spec.js';
 import { LatestOnly } from '../../web/src/lib/latest-only.js';
 import { grow, members, setFromIndices, shrink, vertexAdjacency, weldedTriangles } from '../../web/src/lib/vertex-sets.js';
 
@@ -44,12 +44,14 @@ test('welded triangles join split (seam) vertices', () => {
 
 test('the spec the page saves reads back to the same edit', () => {
   const matrix = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0.5, 0.25, 0, 1];
-  const spec = buildSpec({ handle: [3, 4], fixed: [0], matrix, features: 'scale', options: { coherence_rings: 1 } });
+  const spec = buildSpec({ handles: [[3, 4], [7]], fixed: [0], matrices: [matrix, identity], features: 'scale', options: { coherence_rings: 1 } });
   assert.deepEqual(spec, {
-    handles: [{ select: [3, 4], matrix }], fixed: [0], features: 'scale', options: { coherence_rings: 1 },
+    handles: [{ select: [3, 4], matrix }, { select: [7], matrix: identity }], fixed: [0], features: 'scale', options: { coherence_rings: 1 },
   });
   const back = readSpec(JSON.parse(JSON.stringify(spec)));
-  assert.deepEqual(back, { handle: [3, 4], roi: [], fixed: [0], matrix, features: 'scale', options: { coherence_rings: 1 } });
+  assert.deepEqual(back, { handles: [[3, 4], [7]], roi: [], fixed: [0], matrices: [matrix, identity], features: 'scale', options: { coherence_rings: 1 } });
+  assert.deepEqual(buildSpec({ handles: [[1]] }), { handles: [{ select: [1] }], features: 'keep' });
+  assert.deepEqual(readSpec({ handles: [{ select: [1] }] }).matrices, [identity]);
   assert.deepEqual(readSpec({ handles: [{ select: { indices: [1] } }], roi: [1, 2] }).roi, [1, 2]);
   assert.throws(() => readSpec({ handles: [{ select: { spheres: [] } }] }), /index lists/);
   assert.throws(() => readSpec({ handles: [{ select: [1], translate: [0, 1, 0] }] }), /matrix/);

@@ -1,18 +1,19 @@
 // The edit spec the page builds, sends to editCreate and saves: the same JSON grammar as
-// `meshmorph edit --spec` (app/edit_spec.h), restricted to what the page edits — one handle
-// given by welded vertex indices and a column-major 4x4 "matrix", optional "roi" and "fixed"
+// `meshmorph edit --spec` (app/edit_spec.h), restricted to what the page edits — handles given
+// by welded vertex indices, each with a column-major 4x4 "matrix", optional "roi" and "fixed"
 // index lists, "features" and "options". Reading accepts index lists (plain arrays or
-// {"indices": [...]}) only: selectors (spheres, boxes, slabs…) are evaluated by the core, and the
-// page has to show its selection before it starts a session.
+// {"indices": [...]}) and matrices only: selectors (spheres, boxes, slabs…) and
+// translate/rotate transforms are evaluated by the core, and the page has to show its
+// selection and gizmo before it starts a session.
 import { MeshMorphError } from './errors.js';
 
-const identity = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
+export const identity = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
 
-// {handle, roi, fixed}: sorted welded index arrays (roi/fixed may be empty: then left out);
-// matrix: 16 numbers or null (no transform key: the core's identity); features; options.
-export function buildSpec({ handle, roi = [], fixed = [], matrix = null, features = 'keep', options = {} }) {
-  const spec = { handles: [{ select: [...handle] }] };
-  if (matrix) spec.handles[0].matrix = Array.from(matrix);
+// handles: [sorted welded index array per handle]; matrices: [16 numbers per handle] or null
+// (no transform keys: the core's identity); roi / fixed: sorted welded index arrays (left out
+// when empty); features; options.
+export function buildSpec({ handles, roi = [], fixed = [], matrices = null, features = 'keep', options = {} }) {
+  const spec = { handles: handles.map((select, h) => (matrices ? { select: [...select], matrix: Array.from(matrices[h]) } : { select: [...select] })) };
   if (roi.length) spec.roi = [...roi];
   if (fixed.length) spec.fixed = [...fixed];
   spec.features = features;
@@ -31,29 +32,30 @@ function indexList(selection, what) {
   return list;
 }
 
-// A spec document (parsed JSON) → {handle, roi, fixed, matrix, features, options}; throws
-// MeshMorphError for what the page cannot show.
+// A spec document (parsed JSON) → {handles, roi, fixed, matrices (identity where a handle has
+// none), features, options}; throws MeshMorphError for what the page cannot show.
 export function readSpec(spec) {
   if (!spec || typeof spec !== 'object' || Array.isArray(spec)) throw new MeshMorphError('ParseError', 'an edit spec is a JSON object');
   const handles = spec.handles;
   if (!Array.isArray(handles) || handles.length === 0) throw new MeshMorphError('ParseError', 'the spec has no "handles"');
-  if (handles.length > 1) throw new MeshMorphError('Unsupported', `the spec has ${handles.length} handles; the page edits one handle at a time`);
-  const h = handles[0];
-  const transformKeys = Object.keys(h).filter((k) => !['select', 'matrix'].includes(k));
-  if (transformKeys.length) {
-    throw new MeshMorphError('Unsupported', `the handle's transform uses ${transformKeys.join(', ')}; the page reads "matrix" transforms (as it saves them)`);
-  }
-  const matrix = h.matrix ?? null;
-  if (matrix !== null && (!Array.isArray(matrix) || matrix.length !== 16 || !matrix.every(Number.isFinite))) {
-    throw new MeshMorphError('ParseError', 'the handle\'s "matrix" must be 16 numbers (column-major)');
-  }
+  const matrices = handles.map((h, i) => {
+    const transformKeys = Object.keys(h || {}).filter((k) => !['select', 'matrix'].includes(k));
+    if (transformKeys.length) {
+      throw new MeshMorphError('Unsupported', `handle ${i + 1}'s transform uses ${transformKeys.join(', ')}; the page reads "matrix" transforms (as it saves them)`);
+    }
+    const matrix = h.matrix ?? identity;
+    if (!Array.isArray(matrix) || matrix.length !== 16 || !matrix.every(Number.isFinite)) {
+      throw new MeshMorphError('ParseError', `handle ${i + 1}'s "matrix" must be 16 numbers (column-major)`);
+    }
+    return matrix;
+  });
   const features = spec.features ?? 'keep';
   if (!['keep', 'scale'].includes(features)) throw new MeshMorphError('ParseError', `"features" must be "keep" or "scale", not ${JSON.stringify(features)}`);
   return {
-    handle: indexList(h.select, 'handle'),
+    handles: handles.map((h, i) => indexList(h.select, `handle ${i + 1}`)),
     roi: indexList(spec.roi, 'roi'),
     fixed: indexList(spec.fixed, 'fixed set'),
-    matrix: matrix && !matrix.every((v, i) => v === identity[i]) ? matrix : null,
+    matrices,
     features,
     options: spec.options ?? {},
   };

@@ -1,37 +1,44 @@
 // The Edit job: move a part of the loaded mesh with a gizmo and let the implicit Laplacian
 // editor (docs/edit.md, worker/ops/edit.js) reshape the rest. A guided step list leads through
-//   1 paint the handle (brush: hold B or turn the brush on; Shift erases)
+//   1 paint the handle(s) (brush: hold B or turn the brush on; Shift erases; New handle adds one)
 //   2 optionally paint the fixed part and / or limit the region of interest, then Start editing
-//   3 drag the gizmo (translate / rotate / scale): previews follow at the worker's pace
+//   3 drag the gizmo (translate / rotate / scale) of the chosen handle: previews follow at the
+//     worker's pace
 //   4 on release the shape is finalized; save the spec (the CLI's JSON) or export a GLB.
 // Sets live on the welded mesh (what the core edits; lib/vertex-sets.js), the brush paints
 // displayed vertices (view/brush.js) and maps them through toWelded. Drags go through a
-// latest-only pump (lib/latest-only.js): one editDrag in flight, the newest gizmo matrix next.
-// The spec sent to editCreate plus the gizmo matrix is exactly the spec "Save spec" writes
+// latest-only pump (lib/latest-only.js): one editDrag in flight, the newest gizmo matrices next.
+// The spec sent to editCreate plus the handles' matrices is exactly the spec "Save spec" writes
 // (lib/edit-spec.js), so `meshmorph edit --spec` reproduces the page's result.
-// State it owns (window.__meshmorph.state.edit): {step, handle, roi, fixed (counts), session,
-// matrix, drags: {sent, answered, first, last (ms timestamps), roundTripMs, applyMs (sums: worker round
+// State it owns (window.__meshmorph.state.edit): {step, handle, roi, fixed (vertex counts;
+// handle: of all handles), handles (vertex count per handle), active (the handle painted / on the
+// gizmo), session, matrices (one per handle), drags: {sent, answered, first, last (ms timestamps), roundTripMs, applyMs (sums: worker round
 // trip, updating the geometry)}, finalized, spec (sent to
 // editCreate), saved (last saved spec)}. Test hooks (window.__meshmorph.hooks): editGizmoHandle
 // (name) → client {x, y} of a gizmo handle, editPositions() → {raw, welded} current positions.
-import { buildSpec, readSpec } from '../../lib/edit-spec.js';
+import { buildSpec, identity, readSpec } from '../../lib/edit-spec.js';
 import { LatestOnly } from '../../lib/latest-only.js';
 import { grow, members, setFromIndices, shrink, vertexAdjacency, weldedTriangles } from '../../lib/vertex-sets.js';
 import { Brush } from '../../view/brush.js';
 import { EditGizmo } from '../../view/edit-gizmo.js';
-import { selectionColors } from '../../view/selection-colors.js';
+import { handleColor, selectionColors } from '../../view/selection-colors.js';
 import { download } from '../download.js';
 import { finder, fromHtml } from '../dom.js';
 import { OptionsForm } from '../options-form.js';
 import { StepList } from '../step-list.js';
 
-const identity = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
 const sameMatrix = (a, b) => a && b && a.length === b.length && a.every((v, i) => v === b[i]);
+const sameMatrices = (a, b) => a && b && a.length === b.length && a.every((m, i) => sameMatrix(m, b[i]));
+const rgb = (c) => `rgb(${c.map((v) => Math.round(255 * v)).join(', ')})`;
 
 const markup = `
 <section class="edit">
   <h2>Edit</h2>
   <div id="edit-steps"></div>
+  <div class="row">
+    <label>Handle <select id="edit-handle" title="The handle the brush paints and the gizmo moves"></select></label>
+    <button id="edit-new-handle" type="button" title="Paint another handle (each moves on its own)">New handle</button>
+  </div>
   <div id="edit-select">
     <div class="row paint-targets" role="radiogroup" aria-label="Paint">
       <label class="set-handle"><input type="radio" name="edit-target" value="handle" checked /> Handle</label>
@@ -87,13 +94,13 @@ export const panel = {
     const root = fromHtml(markup);
     const $ = finder(root);
     const edit = {
-      step: 0, handle: 0, roi: 0, fixed: 0, session: false, matrix: identity,
+      step: 0, handle: 0, handles: [0], active: 0, roi: 0, fixed: 0, session: false, matrices: [identity],
       drags: { sent: 0, answered: 0, first: 0, last: 0, roundTripMs: 0, applyMs: 0 }, finalized: 0, spec: null, saved: null,
     };
     state.edit = edit;
 
     const steps = new StepList([
-      { title: 'Select the handle' },
+      { title: 'Select the handle(s)' },
       { title: 'Fixed part / region (optional)' },
       { title: 'Drag the gizmo' },
       { title: 'Save or export' },
@@ -102,19 +109,21 @@ export const panel = {
 
     // ---- the mesh as the panel sees it
     let topology = null;     // {count, toWelded, triangles, adjacency (lazy), restRaw, restWelded}
-    let sets = null;         // {handle, roi, fixed}: Uint8Array per welded vertex
+    let sets = null;         // {handle (label: 0 none, h + 1 handle h), roi, fixed (0/1)}: Uint8Array per welded vertex
+    let handleCount = 1;     // handles offered in the picker (some may still be empty)
+    let centroids = [];      // per handle, in a session: the rest centroid (the gizmo's pivot)
     let welded = null;       // current welded positions (Float32Array #W·3) after a drag/finalize
     let shown = null;        // the same in the raw layout (what the Edit job shows)
-    let history = [identity]; // gizmo matrices; history[at] is the current one
+    let history = [[identity]]; // per step, the matrices of all handles; history[at] is current
     let at = 0;
-    let lastDragged = null;  // the matrix of the last editDrag the worker answered
+    let lastDragged = null;  // the matrices of the last editDrag the worker answered
     let form = null;         // OptionsForm, once the schema arrived
     let visible = false;     // the Edit job is shown
 
     const brush = new Brush(viewer);
     const gizmo = new EditGizmo(viewer, {
-      onChange: (matrix) => { if (edit.session) pump.push(matrix); },
-      onRelease: (matrix) => { if (edit.session) commit(matrix); },
+      onChange: (matrix) => { if (edit.session) pump.push(withActive(matrix)); },
+      onRelease: (matrix) => { if (edit.session) commit(withActive(matrix)); },
     });
 
     function newMesh(mesh) {
@@ -128,6 +137,8 @@ export const panel = {
       }
       topology = { count, toWelded: mesh.toWelded, triangles: weldedTriangles(geometry.index.array, mesh.toWelded), adjacency: null, restRaw, restWelded };
       sets = { handle: new Uint8Array(count), roi: new Uint8Array(count), fixed: new Uint8Array(count) };
+      handleCount = 1;
+      edit.active = 0;
       welded = null;
       endSession({ restore: false });
       refresh();
@@ -142,13 +153,31 @@ export const panel = {
       if (visible && sets) viewer.setColors(selectionColors(sets, topology.toWelded));
     }
 
+    // The welded vertices of handle h (sorted).
+    const handleMembers = (h) => {
+      const out = [];
+      if (sets) for (let w = 0; w < sets.handle.length; ++w) if (sets.handle[w] === h + 1) out.push(w);
+      return out;
+    };
+
     function refresh() {
       const count = (s) => (sets ? members(s).length : 0);
       edit.handle = count(sets?.handle);
+      edit.handles = Array.from({ length: handleCount }, (_, h) => handleMembers(h).length);
+      const picker = $('edit-handle');
+      while (picker.options.length > handleCount) picker.remove(picker.options.length - 1);
+      for (let h = 0; h < handleCount; ++h) {
+        const option = picker.options[h] || picker.appendChild(new Option('', String(h)));
+        option.textContent = `${h + 1} · ${edit.handles[h]} vertices`;
+        option.style.color = rgb(handleColor(h));
+      }
+      picker.value = String(edit.active);
+      picker.style.borderColor = rgb(handleColor(edit.active));
+      $('edit-new-handle').hidden = edit.session;
       edit.roi = count(sets?.roi);
       edit.fixed = count(sets?.fixed);
       $('edit-counts').textContent = sets
-        ? `handle ${edit.handle} · fixed ${edit.fixed} · region ${edit.roi || 'whole part (default)'} (welded vertices)`
+        ? `handles ${edit.handle} · fixed ${edit.fixed} · region ${edit.roi || 'whole part (default)'} (welded vertices)`
         : 'Load a mesh first (Mesh tab).';
       $('edit-select').hidden = edit.session;
       $('edit-drag').hidden = !edit.session;
@@ -158,13 +187,13 @@ export const panel = {
         steps.set(0, 'Load a mesh in the Mesh tab.');
       } else if (!edit.session && !edit.handle) {
         edit.step = 0;
-        steps.set(0, 'Turn on the Brush (or hold B) and paint the part you want to move.');
+        steps.set(0, 'Turn on the Brush (or hold B) and paint the part you want to move; New handle adds another.');
       } else if (!edit.session) {
         edit.step = 1;
         steps.set(1, 'Optionally paint the Fixed part (or a Region), then press Start editing.');
       } else if (edit.finalized === 0) {
         edit.step = 2;
-        steps.set(2, 'Drag an arrow, ring or box of the gizmo (W / E / R: move, rotate, scale).');
+        steps.set(2, `Drag an arrow, ring or box of the gizmo (W / E / R: move, rotate, scale)${handleCount > 1 ? '; Handle picks the one it moves' : ''}.`);
       } else {
         edit.step = 3;
         steps.set(3, 'Save spec or Export GLB — or keep dragging; Undo goes back.');
@@ -190,16 +219,17 @@ export const panel = {
     function paintAt(x, y, erase) {
       const name = target();
       const set = sets[name];
+      const on = name === 'handle' ? edit.active + 1 : 1; // the value painted
       let changed = false;
       for (const r of brush.verticesAt(x, y)) {
         const w = topology.toWelded[r];
         if (erase) {
-          changed ||= set[w] === 1;
-          set[w] = 0;
+          changed ||= set[w] === on;
+          if (set[w] === on) set[w] = 0;
           continue;
         }
-        changed ||= set[w] === 0;
-        set[w] = 1;
+        changed ||= set[w] !== on;
+        set[w] = on;
         if (name === 'handle') sets.fixed[w] = 0; // a vertex is moved or held, not both
         if (name === 'fixed') sets.handle[w] = 0;
       }
@@ -266,11 +296,26 @@ export const panel = {
     });
     brush.setRadius(Number($('edit-radius').value));
 
+    // Grow / shrink / clear the painted set (for handles: the active one; it does not take
+    // vertices of other handles).
     function changeSet(fn) {
       if (!sets) return;
-      fn(sets[target()]);
-      if (target() === 'handle') for (let w = 0; w < topology.count; ++w) if (sets.handle[w]) sets.fixed[w] = 0;
-      if (target() === 'fixed') for (let w = 0; w < topology.count; ++w) if (sets.fixed[w]) sets.handle[w] = 0;
+      if (target() === 'handle') {
+        const label = edit.active + 1;
+        const mask = sets.handle.map((l) => (l === label ? 1 : 0));
+        fn(mask);
+        for (let w = 0; w < topology.count; ++w) {
+          if (mask[w] && (sets.handle[w] === 0 || sets.handle[w] === label)) {
+            sets.handle[w] = label;
+            sets.fixed[w] = 0;
+          } else if (!mask[w] && sets.handle[w] === label) {
+            sets.handle[w] = 0;
+          }
+        }
+      } else {
+        fn(sets[target()]);
+        if (target() === 'fixed') for (let w = 0; w < topology.count; ++w) if (sets.fixed[w]) sets.handle[w] = 0;
+      }
       showColors();
       refresh();
     }
@@ -278,17 +323,41 @@ export const panel = {
     $('edit-shrink').addEventListener('click', () => changeSet((s) => shrink(s, adjacency())));
     $('edit-clear').addEventListener('click', () => changeSet((s) => s.fill(0)));
 
+    $('edit-new-handle').addEventListener('click', () => {
+      if (!sets || edit.session) return;
+      if (handleMembers(handleCount - 1).length) handleCount += 1; // reuse an empty last one
+      edit.active = handleCount - 1;
+      root.querySelector('input[name="edit-target"][value="handle"]').checked = true;
+      refresh();
+    });
+    $('edit-handle').addEventListener('change', () => {
+      edit.active = Number($('edit-handle').value);
+      if (edit.session) attachGizmo();
+      refresh();
+    });
+
     // ---- the session
 
     const features = () => $('edit-features').value;
     // The spec of the current selection and options; in a session, of the session's selection
     // and options (changes wait for the next Start editing) with the current features mode.
-    const currentSpec = (matrix) => {
+    const currentSpec = (matrices) => {
       const base = edit.session ? readSpec(edit.spec) : {
-        handle: members(sets.handle), roi: members(sets.roi), fixed: members(sets.fixed), options: form ? form.values() : {},
+        handles: Array.from({ length: handleCount }, (_, h) => handleMembers(h)).filter((m) => m.length),
+        roi: members(sets.roi), fixed: members(sets.fixed), options: form ? form.values() : {},
       };
-      return buildSpec({ ...base, matrix, features: features() });
+      return buildSpec({ ...base, matrices, features: features() });
     };
+    // The current matrices with the active handle's replaced (a gizmo move).
+    const withActive = (matrix) => history[at].map((m, h) => (h === edit.active ? matrix : m));
+    const dragOptions = (matrices) => ({ transforms: matrices.map((matrix) => ({ matrix })) });
+
+    // The gizmo on the active handle: pivot at its rest centroid, moved by its current matrix.
+    function attachGizmo() {
+      gizmo.attach(centroids[edit.active]);
+      gizmo.setMatrix(history[at][edit.active]);
+      if (!visible) gizmo.hide();
+    }
     // The CLI finalizes only with method "implicit" (the naive baseline has no second step).
     const finalizes = () => (edit.spec?.options?.method ?? 'implicit') === 'implicit';
 
@@ -299,20 +368,20 @@ export const panel = {
     }
 
     const pump = new LatestOnly(
-      (matrix) => {
+      (matrices) => {
         edit.drags.sent += 1;
         const sentAt = performance.now();
         if (!edit.drags.first) edit.drags.first = sentAt;
-        return client.run('editDrag', { transforms: [{ matrix }] }).promise.then((result) => {
+        return client.run('editDrag', dragOptions(matrices)).promise.then((result) => {
           edit.drags.roundTripMs += performance.now() - sentAt;
           return result;
         });
       },
       {
-        onAnswer(result, matrix) {
+        onAnswer(result, matrices) {
           const started = performance.now();
           edit.drags.answered += 1;
-          lastDragged = matrix;
+          lastDragged = matrices;
           show(result);
           edit.drags.last = performance.now();
           edit.drags.applyMs += edit.drags.last - started;
@@ -321,37 +390,38 @@ export const panel = {
       },
     );
 
-    // Brings the mesh to the gizmo matrix and finalizes it (release, undo, redo, reset, mode).
-    async function settle(matrix) {
+    // Brings the mesh to the handles' matrices and finalizes it (release, undo, redo, reset,
+    // features mode).
+    async function settle(matrices) {
       await pump.idle();
-      if (!sameMatrix(lastDragged, matrix)) {
-        const dragged = await app.runOp('Moving the handle', 'editDrag', { transforms: [{ matrix }] });
+      if (!sameMatrices(lastDragged, matrices)) {
+        const dragged = await app.runOp('Moving the handles', 'editDrag', dragOptions(matrices));
         if (!dragged) return false;
-        lastDragged = matrix;
+        lastDragged = matrices;
       }
       if (finalizes()) {
         const result = await app.runOp('Finalizing', 'editFinalize', { mode: features() });
         if (!result) return false;
         show(result);
       }
-      edit.matrix = matrix;
+      edit.matrices = matrices;
       edit.finalized += 1;
       refresh();
       return true;
     }
 
-    async function commit(matrix) {
-      if (sameMatrix(history[at], matrix) && edit.finalized > 0) return; // a click, no move
+    async function commit(matrices) {
+      if (sameMatrices(history[at], matrices) && edit.finalized > 0) return; // a click, no move
       history = history.slice(0, at + 1);
-      history.push(matrix);
+      history.push(matrices);
       at = history.length - 1;
-      await settle(matrix);
+      await settle(matrices);
     }
 
     async function goTo(index) {
       if (!edit.session || index < 0 || index >= history.length || gizmo.dragging) return;
       at = index;
-      gizmo.setMatrix(history[at]);
+      gizmo.setMatrix(history[at][edit.active]);
       await settle(history[at]);
     }
     const undo = () => goTo(at - 1);
@@ -363,35 +433,52 @@ export const panel = {
       if (radio) radio.checked = true;
     }
 
-    async function startSession(matrix = null) {
+    // Handle labels 1..H with no empty one in between (the spec lists non-empty handles only).
+    function compactHandles() {
+      const used = [];
+      for (let h = 0; h < handleCount; ++h) if (handleMembers(h).length) used.push(h + 1);
+      const relabel = new Uint8Array(256);
+      used.forEach((label, i) => { relabel[label] = i + 1; });
+      for (let w = 0; w < sets.handle.length; ++w) sets.handle[w] = relabel[sets.handle[w]];
+      edit.active = Math.max(0, used.indexOf(edit.active + 1));
+      handleCount = Math.max(1, used.length);
+    }
+
+    async function startSession(matrices = null) {
       if (!sets || !members(sets.handle).length) {
         app.showError({ code: 'InvalidArgument', message: 'paint a handle first (step 1): the edit needs at least one handle vertex' });
         return false;
       }
       endSession({ restore: true });
+      compactHandles();
+      refresh();
       const spec = currentSpec(null);
       const result = await app.runOp('Preparing the edit', 'editCreate', { spec });
       if (!result) return false;
       edit.spec = spec;
       edit.session = true;
       edit.finalized = 0;
-      edit.matrix = identity;
+      const rest = Array(handleCount).fill(identity);
+      edit.matrices = rest;
       edit.drags = { sent: 0, answered: 0, first: 0, last: 0, roundTripMs: 0, applyMs: 0 };
       lastDragged = null;
-      history = [identity];
+      history = [rest];
       at = 0;
       brushOn = false;
       keyHeld = false;
-      // The gizmo sits at the centroid of the handle's rest positions (the spec's default pivot).
-      const handle = members(sets.handle);
-      const c = [0, 0, 0];
-      for (const w of handle) for (let k = 0; k < 3; ++k) c[k] += topology.restWelded[3 * w + k] / handle.length;
-      gizmo.attach(c);
+      // Each handle's gizmo pivots about the centroid of its rest positions (the spec's default).
+      centroids = Array.from({ length: handleCount }, (_, h) => {
+        const handle = handleMembers(h);
+        const c = [0, 0, 0];
+        for (const w of handle) for (let k = 0; k < 3; ++k) c[k] += topology.restWelded[3 * w + k] / handle.length;
+        return c;
+      });
+      attachGizmo();
       updateBrush();
-      app.setStatus(`editing: ${result.info.handles[0]} handle vertices, ${result.info.stats.free_vertices} free · prepared in ${result.info.milliseconds} ms`);
-      if (matrix) {
-        gizmo.setMatrix(matrix);
-        await commit(matrix);
+      app.setStatus(`editing: ${result.info.handles.join(' + ')} handle vertices, ${result.info.stats.free_vertices} free · prepared in ${result.info.milliseconds} ms`);
+      if (matrices && !sameMatrices(matrices, rest)) {
+        gizmo.setMatrix(matrices[edit.active]);
+        await commit(matrices);
       }
       return true;
     }
@@ -400,9 +487,9 @@ export const panel = {
       if (edit.session) client.run('editDispose', {}).promise.catch(() => {});
       edit.session = false;
       edit.finalized = 0;
-      edit.matrix = identity;
+      edit.matrices = [identity];
       lastDragged = null;
-      history = [identity];
+      history = [[identity]];
       at = 0;
       gizmo.detach();
       if (restore && topology && shown) viewer.setPositions(topology.restRaw.slice());
@@ -419,9 +506,9 @@ export const panel = {
     $('edit-undo').addEventListener('click', undo);
     $('edit-redo').addEventListener('click', redo);
     $('edit-reset').addEventListener('click', () => {
-      if (!edit.session) return;
+      if (!edit.session || gizmo.dragging) return;
       gizmo.setMatrix(identity);
-      commit(identity);
+      commit(history[at].map(() => identity));
     });
     $('edit-features').addEventListener('change', () => { if (edit.session) settle(history[at]); });
     for (const radio of root.querySelectorAll('input[name="edit-mode"]')) radio.addEventListener('change', () => setMode(radio.value));
@@ -446,11 +533,14 @@ export const panel = {
       let spec;
       try {
         spec = readSpec(JSON.parse(await file.text()));
-        sets = {
-          handle: setFromIndices(spec.handle, topology.count),
-          roi: setFromIndices(spec.roi, topology.count),
-          fixed: setFromIndices(spec.fixed, topology.count),
-        };
+        if (spec.handles.length > 255) throw new RangeError('the page edits at most 255 handles');
+        const handle = new Uint8Array(topology.count);
+        spec.handles.forEach((list, h) => {
+          for (const w of members(setFromIndices(list, topology.count))) handle[w] = h + 1;
+        });
+        sets = { handle, roi: setFromIndices(spec.roi, topology.count), fixed: setFromIndices(spec.fixed, topology.count) };
+        handleCount = spec.handles.length;
+        edit.active = 0;
       } catch (e) {
         app.showError(e instanceof SyntaxError ? { code: 'ParseError', message: `${file.name}: ${e.message}` } : e);
         return;
@@ -460,7 +550,7 @@ export const panel = {
       endSession();
       showColors();
       refresh();
-      await startSession(spec.matrix);
+      await startSession(spec.matrices);
     });
 
     $('edit-export').addEventListener('click', async () => {
