@@ -1,8 +1,9 @@
 // The page's edit helpers without a browser: vertex sets on the welded mesh (adjacency,
-// grow / shrink), the edit spec the page builds, saves and reads back, and the latest-only
+// grow / shrink), the selection with numbered handles, the edit spec the page builds, saves and reads back, and the latest-only
 // drag pump (one request in flight, the newest value next, never a queue of stale ones).
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
+import { EditSelection } from '../../web/src/lib/edit-selection.js';
 import { buildSpec, identity, readSpec } from '../../web/src/lib/edit-spec.js';
 import { LatestOnly } from '../../web/src/lib/latest-only.js';
 import { grow, members, setFromIndices, shrink, vertexAdjacency, weldedTriangles } from '../../web/src/lib/vertex-sets.js';
@@ -92,4 +93,25 @@ test('latest-only pump keeps working after a failed request', async () => {
   await pump.idle();
   assert.deepEqual(errors, ['boom']);
   assert.equal(pump.answered, 1);
+});
+
+test('selection: handles never overlap each other or the fixed set; lists compact empty handles', () => {
+  const adjacency = vertexAdjacency(strip(5), 12);
+  const s = new EditSelection(12);
+  assert.ok(s.paint([0, 1], 'handle', 0, false));
+  assert.equal(s.addHandle(), 1);
+  assert.equal(s.addHandle(), 1); // the new one is still empty: no third handle
+  s.paint([10, 11], 'handle', 1, false);
+  s.paint([11, 9], 'fixed', 0, false); // takes 11 from handle 2
+  assert.deepEqual(s.counts(), { handle: 3, handles: [2, 1], fixed: 2, roi: 0 });
+  s.change('handle', 0, (m) => grow(m, adjacency)); // handle 1 grows into free vertices only
+  assert.deepEqual(s.handleMembers(0), [0, 1, 2, 3]);
+  assert.ok(s.paint([9], 'fixed', 0, true));
+  assert.ok(!s.paint([9], 'fixed', 0, true));
+  s.change('handle', 0, (m) => m.fill(0));
+  assert.deepEqual(s.lists(), { handles: [[10]], roi: [], fixed: [11] });
+  assert.equal(s.compact(1), 0);
+  assert.deepEqual(s.handleMembers(0), [10]);
+  const back = EditSelection.fromLists({ handles: [[0], [5, 6]], fixed: [6, 7] }, 12);
+  assert.deepEqual(back.lists(), { handles: [[0], [5, 6]], roi: [], fixed: [7] });
 });

@@ -5,7 +5,7 @@
 //   3 drag the gizmo (translate / rotate / scale) of the chosen handle: previews follow at the
 //     worker's pace
 //   4 on release the shape is finalized; save the spec (the CLI's JSON) or export a GLB.
-// Sets live on the welded mesh (what the core edits; lib/vertex-sets.js), the brush paints
+// Sets live on the welded mesh (what the core edits; lib/edit-selection.js), the brush paints
 // displayed vertices (view/brush.js) and maps them through toWelded. Drags go through a
 // latest-only pump (lib/latest-only.js): one editDrag in flight, the newest gizmo matrices next.
 // The spec sent to editCreate plus the handles' matrices is exactly the spec "Save spec" writes
@@ -18,7 +18,8 @@
 // (name) → client {x, y} of a gizmo handle, editPositions() → {raw, welded} current positions.
 import { buildSpec, identity, readSpec } from '../../lib/edit-spec.js';
 import { LatestOnly } from '../../lib/latest-only.js';
-import { grow, members, setFromIndices, shrink, vertexAdjacency, weldedTriangles } from '../../lib/vertex-sets.js';
+import { EditSelection } from '../../lib/edit-selection.js';
+import { grow, shrink, vertexAdjacency, weldedTriangles } from '../../lib/vertex-sets.js';
 import { Brush } from '../../view/brush.js';
 import { EditGizmo } from '../../view/edit-gizmo.js';
 import { handleColor, selectionColors } from '../../view/selection-colors.js';
@@ -109,8 +110,7 @@ export const panel = {
 
     // ---- the mesh as the panel sees it
     let topology = null;     // {count, toWelded, triangles, adjacency (lazy), restRaw, restWelded}
-    let sets = null;         // {handle (label: 0 none, h + 1 handle h), roi, fixed (0/1)}: Uint8Array per welded vertex
-    let handleCount = 1;     // handles offered in the picker (some may still be empty)
+    let sets = null;         // EditSelection of the loaded mesh
     let centroids = [];      // per handle, in a session: the rest centroid (the gizmo's pivot)
     let welded = null;       // current welded positions (Float32Array #W·3) after a drag/finalize
     let shown = null;        // the same in the raw layout (what the Edit job shows)
@@ -136,8 +136,7 @@ export const panel = {
         restWelded.set(restRaw.subarray(3 * r, 3 * r + 3), 3 * w);
       }
       topology = { count, toWelded: mesh.toWelded, triangles: weldedTriangles(geometry.index.array, mesh.toWelded), adjacency: null, restRaw, restWelded };
-      sets = { handle: new Uint8Array(count), roi: new Uint8Array(count), fixed: new Uint8Array(count) };
-      handleCount = 1;
+      sets = new EditSelection(count);
       edit.active = 0;
       welded = null;
       endSession({ restore: false });
@@ -153,17 +152,10 @@ export const panel = {
       if (visible && sets) viewer.setColors(selectionColors(sets, topology.toWelded));
     }
 
-    // The welded vertices of handle h (sorted).
-    const handleMembers = (h) => {
-      const out = [];
-      if (sets) for (let w = 0; w < sets.handle.length; ++w) if (sets.handle[w] === h + 1) out.push(w);
-      return out;
-    };
-
     function refresh() {
-      const count = (s) => (sets ? members(s).length : 0);
-      edit.handle = count(sets?.handle);
-      edit.handles = Array.from({ length: handleCount }, (_, h) => handleMembers(h).length);
+      const counts = sets ? sets.counts() : { handle: 0, handles: [0], roi: 0, fixed: 0 };
+      Object.assign(edit, counts);
+      const handleCount = counts.handles.length;
       const picker = $('edit-handle');
       while (picker.options.length > handleCount) picker.remove(picker.options.length - 1);
       for (let h = 0; h < handleCount; ++h) {
@@ -174,8 +166,6 @@ export const panel = {
       picker.value = String(edit.active);
       picker.style.borderColor = rgb(handleColor(edit.active));
       $('edit-new-handle').hidden = edit.session;
-      edit.roi = count(sets?.roi);
-      edit.fixed = count(sets?.fixed);
       $('edit-counts').textContent = sets
         ? `handles ${edit.handle} · fixed ${edit.fixed} · region ${edit.roi || 'whole part (default)'} (welded vertices)`
         : 'Load a mesh first (Mesh tab).';
@@ -193,7 +183,7 @@ export const panel = {
         steps.set(1, 'Optionally paint the Fixed part (or a Region), then press Start editing.');
       } else if (edit.finalized === 0) {
         edit.step = 2;
-        steps.set(2, `Drag an arrow, ring or box of the gizmo (W / E / R: move, rotate, scale)${handleCount > 1 ? '; Handle picks the one it moves' : ''}.`);
+        steps.set(2, `Drag an arrow, ring or box of the gizmo (W / E / R: move, rotate, scale)${sets.handleCount > 1 ? '; Handle picks the one it moves' : ''}.`);
       } else {
         edit.step = 3;
         steps.set(3, 'Save spec or Export GLB — or keep dragging; Undo goes back.');
@@ -217,23 +207,8 @@ export const panel = {
     }
 
     function paintAt(x, y, erase) {
-      const name = target();
-      const set = sets[name];
-      const on = name === 'handle' ? edit.active + 1 : 1; // the value painted
-      let changed = false;
-      for (const r of brush.verticesAt(x, y)) {
-        const w = topology.toWelded[r];
-        if (erase) {
-          changed ||= set[w] === on;
-          if (set[w] === on) set[w] = 0;
-          continue;
-        }
-        changed ||= set[w] !== on;
-        set[w] = on;
-        if (name === 'handle') sets.fixed[w] = 0; // a vertex is moved or held, not both
-        if (name === 'fixed') sets.handle[w] = 0;
-      }
-      if (changed) {
+      const vertices = brush.verticesAt(x, y).map((r) => topology.toWelded[r]);
+      if (sets.paint(vertices, target(), edit.active, erase)) {
         showColors();
         refresh();
       }
@@ -296,26 +271,10 @@ export const panel = {
     });
     brush.setRadius(Number($('edit-radius').value));
 
-    // Grow / shrink / clear the painted set (for handles: the active one; it does not take
-    // vertices of other handles).
+    // Grow / shrink / clear the painted set (for handles: the active one).
     function changeSet(fn) {
       if (!sets) return;
-      if (target() === 'handle') {
-        const label = edit.active + 1;
-        const mask = sets.handle.map((l) => (l === label ? 1 : 0));
-        fn(mask);
-        for (let w = 0; w < topology.count; ++w) {
-          if (mask[w] && (sets.handle[w] === 0 || sets.handle[w] === label)) {
-            sets.handle[w] = label;
-            sets.fixed[w] = 0;
-          } else if (!mask[w] && sets.handle[w] === label) {
-            sets.handle[w] = 0;
-          }
-        }
-      } else {
-        fn(sets[target()]);
-        if (target() === 'fixed') for (let w = 0; w < topology.count; ++w) if (sets.fixed[w]) sets.handle[w] = 0;
-      }
+      sets.change(target(), edit.active, fn);
       showColors();
       refresh();
     }
@@ -325,8 +284,7 @@ export const panel = {
 
     $('edit-new-handle').addEventListener('click', () => {
       if (!sets || edit.session) return;
-      if (handleMembers(handleCount - 1).length) handleCount += 1; // reuse an empty last one
-      edit.active = handleCount - 1;
+      edit.active = sets.addHandle();
       root.querySelector('input[name="edit-target"][value="handle"]').checked = true;
       refresh();
     });
@@ -342,10 +300,7 @@ export const panel = {
     // The spec of the current selection and options; in a session, of the session's selection
     // and options (changes wait for the next Start editing) with the current features mode.
     const currentSpec = (matrices) => {
-      const base = edit.session ? readSpec(edit.spec) : {
-        handles: Array.from({ length: handleCount }, (_, h) => handleMembers(h)).filter((m) => m.length),
-        roi: members(sets.roi), fixed: members(sets.fixed), options: form ? form.values() : {},
-      };
+      const base = edit.session ? readSpec(edit.spec) : { ...sets.lists(), options: form ? form.values() : {} };
       return buildSpec({ ...base, matrices, features: features() });
     };
     // The current matrices with the active handle's replaced (a gizmo move).
@@ -433,24 +388,13 @@ export const panel = {
       if (radio) radio.checked = true;
     }
 
-    // Handle labels 1..H with no empty one in between (the spec lists non-empty handles only).
-    function compactHandles() {
-      const used = [];
-      for (let h = 0; h < handleCount; ++h) if (handleMembers(h).length) used.push(h + 1);
-      const relabel = new Uint8Array(256);
-      used.forEach((label, i) => { relabel[label] = i + 1; });
-      for (let w = 0; w < sets.handle.length; ++w) sets.handle[w] = relabel[sets.handle[w]];
-      edit.active = Math.max(0, used.indexOf(edit.active + 1));
-      handleCount = Math.max(1, used.length);
-    }
-
     async function startSession(matrices = null) {
-      if (!sets || !members(sets.handle).length) {
+      if (!sets || !sets.counts().handle) {
         app.showError({ code: 'InvalidArgument', message: 'paint a handle first (step 1): the edit needs at least one handle vertex' });
         return false;
       }
       endSession({ restore: true });
-      compactHandles();
+      edit.active = sets.compact(edit.active);
       refresh();
       const spec = currentSpec(null);
       const result = await app.runOp('Preparing the edit', 'editCreate', { spec });
@@ -458,7 +402,7 @@ export const panel = {
       edit.spec = spec;
       edit.session = true;
       edit.finalized = 0;
-      const rest = Array(handleCount).fill(identity);
+      const rest = Array(sets.handleCount).fill(identity);
       edit.matrices = rest;
       edit.drags = { sent: 0, answered: 0, first: 0, last: 0, roundTripMs: 0, applyMs: 0 };
       lastDragged = null;
@@ -467,8 +411,8 @@ export const panel = {
       brushOn = false;
       keyHeld = false;
       // Each handle's gizmo pivots about the centroid of its rest positions (the spec's default).
-      centroids = Array.from({ length: handleCount }, (_, h) => {
-        const handle = handleMembers(h);
+      centroids = Array.from({ length: sets.handleCount }, (_, h) => {
+        const handle = sets.handleMembers(h);
         const c = [0, 0, 0];
         for (const w of handle) for (let k = 0; k < 3; ++k) c[k] += topology.restWelded[3 * w + k] / handle.length;
         return c;
@@ -516,7 +460,7 @@ export const panel = {
     // ---- save, load, export
 
     $('edit-save').addEventListener('click', () => {
-      if (!sets || !members(sets.handle).length) {
+      if (!sets || !sets.counts().handle) {
         app.showError({ code: 'InvalidArgument', message: 'paint a handle first: a spec needs at least one handle vertex' });
         return;
       }
@@ -533,13 +477,7 @@ export const panel = {
       let spec;
       try {
         spec = readSpec(JSON.parse(await file.text()));
-        if (spec.handles.length > 255) throw new RangeError('the page edits at most 255 handles');
-        const handle = new Uint8Array(topology.count);
-        spec.handles.forEach((list, h) => {
-          for (const w of members(setFromIndices(list, topology.count))) handle[w] = h + 1;
-        });
-        sets = { handle, roi: setFromIndices(spec.roi, topology.count), fixed: setFromIndices(spec.fixed, topology.count) };
-        handleCount = spec.handles.length;
+        sets = EditSelection.fromLists(spec, topology.count);
         edit.active = 0;
       } catch (e) {
         app.showError(e instanceof SyntaxError ? { code: 'ParseError', message: `${file.name}: ${e.message}` } : e);
