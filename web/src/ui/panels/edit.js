@@ -6,8 +6,8 @@
 //     worker's pace
 //   4 on release the shape is finalized; save the spec (the CLI's JSON) or export a GLB.
 // Sets live on the welded mesh (what the core edits; lib/edit-selection.js), the brush paints
-// displayed vertices (view/brush.js) and maps them through toWelded. Drags go through a
-// latest-only pump (lib/latest-only.js): one editDrag in flight, the newest gizmo matrices next.
+// displayed vertices (view/brush.js) and maps them through toWelded. Moves (previews through a
+// latest-only pump, finalize, undo / redo) are ui/edit-moves.js.
 // The spec sent to editCreate plus the handles' matrices is exactly the spec "Save spec" writes
 // (lib/edit-spec.js), so `meshmorph edit --spec` reproduces the page's result.
 // State it owns (window.__meshmorph.state.edit): {step, handle, roi, fixed (vertex counts;
@@ -17,7 +17,7 @@
 // editCreate), saved (last saved spec)}. Test hooks (window.__meshmorph.hooks): editGizmoHandle
 // (name) → client {x, y} of a gizmo handle, editPositions() → {raw, welded} current positions.
 import { buildSpec, identity, readSpec } from '../../lib/edit-spec.js';
-import { LatestOnly } from '../../lib/latest-only.js';
+import { EditMoves, sameMatrices } from '../edit-moves.js';
 import { EditSelection } from '../../lib/edit-selection.js';
 import { grow, shrink, vertexAdjacency, weldedTriangles } from '../../lib/vertex-sets.js';
 import { Brush } from '../../view/brush.js';
@@ -28,8 +28,6 @@ import { finder, fromHtml } from '../dom.js';
 import { OptionsForm } from '../options-form.js';
 import { StepList } from '../step-list.js';
 
-const sameMatrix = (a, b) => a && b && a.length === b.length && a.every((v, i) => v === b[i]);
-const sameMatrices = (a, b) => a && b && a.length === b.length && a.every((m, i) => sameMatrix(m, b[i]));
 const rgb = (c) => `rgb(${c.map((v) => Math.round(255 * v)).join(', ')})`;
 
 const markup = `
@@ -114,16 +112,13 @@ export const panel = {
     let centroids = [];      // per handle, in a session: the rest centroid (the gizmo's pivot)
     let welded = null;       // current welded positions (Float32Array #W·3) after a drag/finalize
     let shown = null;        // the same in the raw layout (what the Edit job shows)
-    let history = [[identity]]; // per step, the matrices of all handles; history[at] is current
-    let at = 0;
-    let lastDragged = null;  // the matrices of the last editDrag the worker answered
     let form = null;         // OptionsForm, once the schema arrived
     let visible = false;     // the Edit job is shown
 
     const brush = new Brush(viewer);
     const gizmo = new EditGizmo(viewer, {
-      onChange: (matrix) => { if (edit.session) pump.push(withActive(matrix)); },
-      onRelease: (matrix) => { if (edit.session) commit(withActive(matrix)); },
+      onChange: (matrix) => { if (edit.session) moves.preview(moves.with(edit.active, matrix)); },
+      onRelease: (matrix) => { if (edit.session) moves.commit(moves.with(edit.active, matrix)); },
     });
 
     function newMesh(mesh) {
@@ -303,14 +298,11 @@ export const panel = {
       const base = edit.session ? readSpec(edit.spec) : { ...sets.lists(), options: form ? form.values() : {} };
       return buildSpec({ ...base, matrices, features: features() });
     };
-    // The current matrices with the active handle's replaced (a gizmo move).
-    const withActive = (matrix) => history[at].map((m, h) => (h === edit.active ? matrix : m));
-    const dragOptions = (matrices) => ({ transforms: matrices.map((matrix) => ({ matrix })) });
 
     // The gizmo on the active handle: pivot at its rest centroid, moved by its current matrix.
     function attachGizmo() {
       gizmo.attach(centroids[edit.active]);
-      gizmo.setMatrix(history[at][edit.active]);
+      gizmo.setMatrix(moves.current[edit.active]);
       if (!visible) gizmo.hide();
     }
     // The CLI finalizes only with method "implicit" (the naive baseline has no second step).
@@ -322,65 +314,28 @@ export const panel = {
       if (visible) viewer.setPositions(shown);
     }
 
-    const pump = new LatestOnly(
-      (matrices) => {
-        edit.drags.sent += 1;
-        const sentAt = performance.now();
-        if (!edit.drags.first) edit.drags.first = sentAt;
-        return client.run('editDrag', dragOptions(matrices)).promise.then((result) => {
-          edit.drags.roundTripMs += performance.now() - sentAt;
-          return result;
-        });
+    const moves = new EditMoves({
+      client,
+      runOp: (...args) => app.runOp(...args),
+      mode: features,
+      finalizes,
+      onPositions: show,
+      onSettled(matrices) {
+        edit.matrices = matrices;
+        edit.finalized = moves.finalized;
+        refresh();
       },
-      {
-        onAnswer(result, matrices) {
-          const started = performance.now();
-          edit.drags.answered += 1;
-          lastDragged = matrices;
-          show(result);
-          edit.drags.last = performance.now();
-          edit.drags.applyMs += edit.drags.last - started;
-        },
-        onError: (e) => app.showError(e),
-      },
-    );
+      onError: (e) => app.showError(e),
+    });
+    edit.drags = moves.stats;
 
-    // Brings the mesh to the handles' matrices and finalizes it (release, undo, redo, reset,
-    // features mode).
-    async function settle(matrices) {
-      await pump.idle();
-      if (!sameMatrices(lastDragged, matrices)) {
-        const dragged = await app.runOp('Moving the handles', 'editDrag', dragOptions(matrices));
-        if (!dragged) return false;
-        lastDragged = matrices;
-      }
-      if (finalizes()) {
-        const result = await app.runOp('Finalizing', 'editFinalize', { mode: features() });
-        if (!result) return false;
-        show(result);
-      }
-      edit.matrices = matrices;
-      edit.finalized += 1;
-      refresh();
-      return true;
+    async function step(delta) {
+      if (!edit.session || gizmo.dragging) return;
+      const matrices = await moves.step(delta);
+      if (matrices) gizmo.setMatrix(matrices[edit.active]);
     }
-
-    async function commit(matrices) {
-      if (sameMatrices(history[at], matrices) && edit.finalized > 0) return; // a click, no move
-      history = history.slice(0, at + 1);
-      history.push(matrices);
-      at = history.length - 1;
-      await settle(matrices);
-    }
-
-    async function goTo(index) {
-      if (!edit.session || index < 0 || index >= history.length || gizmo.dragging) return;
-      at = index;
-      gizmo.setMatrix(history[at][edit.active]);
-      await settle(history[at]);
-    }
-    const undo = () => goTo(at - 1);
-    const redo = () => goTo(at + 1);
+    const undo = () => step(-1);
+    const redo = () => step(+1);
 
     function setMode(mode) {
       gizmo.setMode(mode);
@@ -402,12 +357,9 @@ export const panel = {
       edit.spec = spec;
       edit.session = true;
       edit.finalized = 0;
-      const rest = Array(sets.handleCount).fill(identity);
-      edit.matrices = rest;
-      edit.drags = { sent: 0, answered: 0, first: 0, last: 0, roundTripMs: 0, applyMs: 0 };
-      lastDragged = null;
-      history = [rest];
-      at = 0;
+      moves.reset(sets.handleCount);
+      edit.matrices = moves.current;
+      edit.drags = moves.stats;
       brushOn = false;
       keyHeld = false;
       // Each handle's gizmo pivots about the centroid of its rest positions (the spec's default).
@@ -420,9 +372,9 @@ export const panel = {
       attachGizmo();
       updateBrush();
       app.setStatus(`editing: ${result.info.handles.join(' + ')} handle vertices, ${result.info.stats.free_vertices} free · prepared in ${result.info.milliseconds} ms`);
-      if (matrices && !sameMatrices(matrices, rest)) {
+      if (matrices && !sameMatrices(matrices, moves.current)) {
         gizmo.setMatrix(matrices[edit.active]);
-        await commit(matrices);
+        await moves.commit(matrices);
       }
       return true;
     }
@@ -432,9 +384,8 @@ export const panel = {
       edit.session = false;
       edit.finalized = 0;
       edit.matrices = [identity];
-      lastDragged = null;
-      history = [[identity]];
-      at = 0;
+      moves.reset(1);
+      edit.drags = moves.stats;
       gizmo.detach();
       if (restore && topology && shown) viewer.setPositions(topology.restRaw.slice());
       welded = null;
@@ -452,9 +403,9 @@ export const panel = {
     $('edit-reset').addEventListener('click', () => {
       if (!edit.session || gizmo.dragging) return;
       gizmo.setMatrix(identity);
-      commit(history[at].map(() => identity));
+      moves.commit(moves.current.map(() => identity));
     });
-    $('edit-features').addEventListener('change', () => { if (edit.session) settle(history[at]); });
+    $('edit-features').addEventListener('change', () => { if (edit.session) moves.settle(); });
     for (const radio of root.querySelectorAll('input[name="edit-mode"]')) radio.addEventListener('change', () => setMode(radio.value));
 
     // ---- save, load, export
@@ -464,7 +415,7 @@ export const panel = {
         app.showError({ code: 'InvalidArgument', message: 'paint a handle first: a spec needs at least one handle vertex' });
         return;
       }
-      const spec = currentSpec(edit.session ? history[at] : null);
+      const spec = currentSpec(edit.session ? moves.current : null);
       edit.saved = spec;
       const stem = state.mesh.name.replace(/\.[^.]*$/, '');
       download(new TextEncoder().encode(`${JSON.stringify(spec, null, 1)}\n`), `${stem}.edit.json`, 'application/json');
