@@ -472,16 +472,18 @@ it('edit: brush two handles and a fixed part, drag the gizmo, finalize; the save
   edit = await editState(page);
   check(edit.handles.length === 2 && edit.handles[1] > 0 && edit.active === 1, `second handle: ${JSON.stringify(edit.handles)}`);
   await page.selectOption('#edit-handle', '0');
-  // 2: the fixed part — the lowest visible vertices of both feet.
+  // 2: the fixed part — the lowest visible vertices of both feet, painted holding B (brush off).
+  await page.click('#edit-brush');
   await page.check('input[name="edit-target"][value="fixed"]');
   for (const key of ['-y - 0.5 * x', '-y + 0.5 * x']) {
     const foot = await visibleVertex(page, key);
     check(foot, `no visible vertex for ${key}`);
+    await page.keyboard.down('b');
     await stroke(page, foot);
+    await page.keyboard.up('b');
   }
   await page.click('#edit-grow');
   await page.click('#edit-grow');
-  await page.click('#edit-brush');
   edit = await editState(page);
   check(edit.fixed > 0, 'the brush selected no fixed vertex');
   await nextFrame(page);
@@ -602,6 +604,13 @@ it('edit: brush two handles and a fixed part, drag the gizmo, finalize; the save
   check(reloadError <= 1e-6 * diagonal, `the loaded spec gives a shape ${reloadError / diagonal}·diag away`);
   await nextFrame(page);
   await shot(page, '11-edit-5-loaded-spec');
+  // Other jobs show the loaded mesh; the edit comes back with the Edit tab.
+  await page.click('#jobs button[data-job="mesh"]');
+  const inMesh = (await page.evaluate(() => window.__meshmorph.hooks.editPositions())).raw;
+  check(inMesh.every((v, i) => v === Math.fround(rest[i])), 'the Mesh job shows the edited mesh');
+  await page.click('#jobs button[data-job="edit"]');
+  const back = (await page.evaluate(() => window.__meshmorph.hooks.editPositions())).raw;
+  check(back.every((v, i) => v === reloaded[i]), 'the edit is not shown again in the Edit tab');
   await page.click('#edit-stop');
   await page.click('#jobs button[data-job="mesh"]');
 });

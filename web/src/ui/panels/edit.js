@@ -11,20 +11,19 @@
 // The spec sent to editCreate plus the handles' matrices is exactly the spec "Save spec" writes
 // (lib/edit-spec.js), so `meshmorph edit --spec` reproduces the page's result.
 // State it owns (window.__meshmorph.state.edit): {step, handle, roi, fixed (vertex counts;
-// handle: of all handles), handles (vertex count per handle), active (the handle painted / on the
-// gizmo), session, matrices (one per handle), drags: {sent, answered, first, last (ms timestamps), roundTripMs, applyMs (sums: worker round
-// trip, updating the geometry)}, finalized, spec (sent to
-// editCreate), saved (last saved spec)}. Test hooks (window.__meshmorph.hooks): editGizmoHandle
-// (name) → client {x, y} of a gizmo handle, editPositions() → {raw, welded} current positions.
-import { buildSpec, identity, readSpec } from '../../lib/edit-spec.js';
-import { EditMoves, sameMatrices } from '../edit-moves.js';
+// handle: of all handles), handles (vertex count per handle), active (the handle painted / on
+// the gizmo), session, matrices (one per handle), drags (ui/edit-moves.js stats), finalized,
+// spec (sent to editCreate), saved (last saved spec)}. Test hooks (window.__meshmorph.hooks):
+// editGizmoHandle(name) → client {x, y} of a gizmo handle, editPositions() → {raw, welded}.
 import { EditSelection } from '../../lib/edit-selection.js';
+import { buildSpec, identity, readSpec } from '../../lib/edit-spec.js';
 import { grow, shrink, vertexAdjacency, weldedTriangles } from '../../lib/vertex-sets.js';
 import { Brush } from '../../view/brush.js';
 import { EditGizmo } from '../../view/edit-gizmo.js';
 import { handleColor, selectionColors } from '../../view/selection-colors.js';
 import { download } from '../download.js';
 import { finder, fromHtml } from '../dom.js';
+import { EditMoves, sameMatrices } from '../edit-moves.js';
 import { OptionsForm } from '../options-form.js';
 import { StepList } from '../step-list.js';
 
