@@ -45,6 +45,18 @@ export class Brush {
     return this.cache.projected;
   }
 
+  // Raw vertices the circle covers moving from client position `from` to `to` (samples every
+  // half radius up to `to`, so a fast stroke leaves no gaps), each once.
+  verticesAlong(from, to) {
+    const steps = Math.max(1, Math.ceil(Math.hypot(to.x - from.x, to.y - from.y) / (0.5 * this.radius)));
+    const out = new Set();
+    for (let i = 1; i <= steps; ++i) { // `from` itself was painted by the previous call
+      const t = i / steps;
+      for (const v of this.verticesAt(from.x + t * (to.x - from.x), from.y + t * (to.y - from.y))) out.add(v);
+    }
+    return [...out];
+  }
+
   // Raw vertices under the circle at a client position that the camera sees.
   verticesAt(clientX, clientY) {
     if (!this.viewer.geometry.getAttribute('position')) return [];

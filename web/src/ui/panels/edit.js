@@ -200,8 +200,10 @@ export const panel = {
       refresh();
     }
 
+    let lastPainted = null; // where the stroke painted last: a fast move paints the way between
     function paintAt(x, y, erase) {
-      const vertices = brush.verticesAt(x, y).map((r) => topology.toWelded[r]);
+      const vertices = brush.verticesAlong(lastPainted ?? { x, y }, { x, y }).map((r) => topology.toWelded[r]);
+      lastPainted = { x, y };
       if (sets.paint(vertices, target(), edit.active, erase)) {
         showColors();
         refresh();
@@ -214,6 +216,7 @@ export const panel = {
       painting = true;
       canvas.setPointerCapture(e.pointerId);
       pointer = { x: e.clientX, y: e.clientY, shift: e.shiftKey };
+      lastPainted = null;
       paintAt(e.clientX, e.clientY, e.shiftKey);
     });
     canvas.addEventListener('pointermove', (e) => {
