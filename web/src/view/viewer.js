@@ -130,11 +130,11 @@ export class Viewer {
   }
 
   // New positions for the shown mesh (#R·3, raw layout; same triangles), e.g. an edit preview:
-  // updated in place, normals recomputed, the picking BVH refitted.
+  // updated in place, normals recomputed, the picking BVH refitted at the next pick.
   setPositions(positions) {
     applyArrays(this.geometry, { positions });
     this.geometry.computeVertexNormals();
-    this.picker.refit();
+    this.picker.refitLater();
     this.requestRender();
   }
 
