@@ -427,7 +427,8 @@ async function waitFinalized(page, n) {
   check(!error, `edit error: ${JSON.stringify(error)}`);
 }
 
-it('edit: brush two handles and a fixed part, drag the gizmo, finalize; the saved spec gives the CLI the same mesh', async ({ page }) => {
+it('edit: brush two handles and a fixed part, drag the gizmo, finalize; the saved spec gives the CLI the same mesh', async ({ page, pageErrors }) => {
+  const errorsBefore = pageErrors.length;
   const restFile = path.join(repoDir, 'data/edit/armadillo.ply');
   const rest = readPlyVertices(fs.readFileSync(restFile));
   const diagonal = bboxDiagonal(rest);
@@ -611,6 +612,7 @@ it('edit: brush two handles and a fixed part, drag the gizmo, finalize; the save
   await page.click('#jobs button[data-job="edit"]');
   const back = (await page.evaluate(() => window.__meshmorph.hooks.editPositions())).raw;
   check(back.every((v, i) => v === reloaded[i]), 'the edit is not shown again in the Edit tab');
+  check(pageErrors.length === errorsBefore, `uncaught page errors: ${pageErrors.slice(errorsBefore).join(' | ')}`);
   await page.click('#edit-stop');
   await page.click('#jobs button[data-job="mesh"]');
 });
