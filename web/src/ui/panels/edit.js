@@ -159,6 +159,7 @@ export const panel = {
       }
       picker.value = String(edit.active);
       picker.style.borderColor = rgb(handleColor(edit.active));
+      root.querySelector('.set-handle').style.borderColor = rgb(handleColor(edit.active));
       $('edit-new-handle').hidden = edit.session;
       $('edit-counts').textContent = sets
         ? `handles ${edit.handle} · fixed ${edit.fixed} · region ${edit.roi || 'whole part (default)'} (welded vertices)`
