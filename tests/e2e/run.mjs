@@ -427,6 +427,22 @@ async function waitFinalized(page, n) {
   check(!error, `edit error: ${JSON.stringify(error)}`);
 }
 
+// Runs `meshmorph edit` on a spec the page saved and compares its vertices with the page's
+// (raw layout, as displayed).
+function cliMatchesPage(meshFile, specFile, pagePositions, diagonal, label) {
+  check(fs.existsSync(cliPath), `the CLI is missing: ${cliPath} (set MM_CLI)`);
+  const out = path.join(shotDir, `${path.basename(specFile, '.json')}-cli.ply`);
+  const run = spawnSync(cliPath, ['edit', meshFile, '--spec', specFile, '--out', out, '--quiet'], { encoding: 'utf8', timeout: 120000 });
+  check(run.status === 0, `meshmorph edit failed (${run.status}): ${run.stderr}`);
+  const cli = readPlyVertices(fs.readFileSync(out));
+  check(cli.length === pagePositions.length, `the CLI wrote ${cli.length / 3} vertices, the page shows ${pagePositions.length / 3}`);
+  let error = 0;
+  const p = pagePositions;
+  for (let i = 0; i < cli.length; i += 3) error = Math.max(error, Math.hypot(cli[i] - p[i], cli[i + 1] - p[i + 1], cli[i + 2] - p[i + 2]));
+  console.log(`     page vs CLI (${label}): max vertex difference ${(error / diagonal).toExponential(2)}·diag`);
+  check(error <= 1e-6 * diagonal, `page and CLI (${label}) differ by ${error / diagonal}·diag`);
+}
+
 it('edit: brush two handles and a fixed part, drag the gizmo, finalize; the saved spec gives the CLI the same mesh', async ({ page, pageErrors }) => {
   const errorsBefore = pageErrors.length;
   const restFile = path.join(repoDir, 'data/edit/armadillo.ply');
@@ -565,16 +581,7 @@ it('edit: brush two handles and a fixed part, drag the gizmo, finalize; the save
   const spec = JSON.parse(fs.readFileSync(specFile, 'utf8'));
   check(JSON.stringify(spec.handles.map((h) => h.matrix)) === JSON.stringify(edit.matrices), 'the saved matrices are not the ones the page sent');
   check(JSON.stringify({ ...spec, handles: spec.handles.map((h) => ({ select: h.select })) }) === JSON.stringify(edit.spec), 'the saved spec differs from the one the page created the session with');
-  check(fs.existsSync(cliPath), `the CLI is missing: ${cliPath} (set MM_CLI)`);
-  const cliOut = path.join(shotDir, 'armadillo-edit-cli.ply');
-  const run = spawnSync(cliPath, ['edit', restFile, '--spec', specFile, '--out', cliOut, '--quiet'], { encoding: 'utf8', timeout: 120000 });
-  check(run.status === 0, `meshmorph edit failed (${run.status}): ${run.stderr}`);
-  const cli = readPlyVertices(fs.readFileSync(cliOut));
-  check(cli.length === raw.length, `the CLI wrote ${cli.length / 3} vertices, the page shows ${raw.length / 3}`);
-  let cliError = 0;
-  for (let i = 0; i < cli.length; i += 3) cliError = Math.max(cliError, Math.hypot(cli[i] - raw[i], cli[i + 1] - raw[i + 1], cli[i + 2] - raw[i + 2]));
-  console.log(`     page vs CLI: max vertex difference ${(cliError / diagonal).toExponential(2)}·diag`);
-  check(cliError <= 1e-6 * diagonal, `page and CLI differ by ${cliError / diagonal}·diag`);
+  cliMatchesPage(restFile, specFile, raw, diagonal, 'translate');
 
   // Undo goes back to the rest shape, redo to the edit.
   await page.click('#edit-undo');
@@ -585,6 +592,32 @@ it('edit: brush two handles and a fixed part, drag the gizmo, finalize; the save
   check(undoError < 1e-5 * diagonal, `undo left the mesh ${undoError / diagonal}·diag from rest`);
   await page.click('#edit-redo');
   await waitFinalized(page, 3);
+
+  // Scale mode (key R): stretch handle 1 along its Y axis with the real mouse; the saved spec
+  // (a matrix with a linear part now) again gives the CLI the page's vertices.
+  await page.keyboard.press('r');
+  check(await page.isChecked('input[name="edit-mode"][value="scale"]'), 'the R key did not select the scale gizmo');
+  await nextFrame(page);
+  const scaleY = await page.evaluate(() => window.__meshmorph.hooks.editGizmoHandle('Y'));
+  check(scaleY && Number.isFinite(scaleY.x), 'no scale gizmo on screen');
+  await page.mouse.move(scaleY.x, scaleY.y, { steps: 2 });
+  await page.mouse.down();
+  for (let i = 1; i <= 10; ++i) await page.mouse.move(scaleY.x, scaleY.y - 3 * i);
+  await page.mouse.up();
+  await waitFinalized(page, 4);
+  edit = await editState(page);
+  const scaled = edit.matrices[0];
+  const yScale = Math.hypot(scaled[4], scaled[5], scaled[6]);
+  check(Math.abs(yScale - 1) > 0.05 && Math.abs(Math.hypot(scaled[0], scaled[1], scaled[2]) - 1) < 1e-9, `scale drag gave ${JSON.stringify(scaled.slice(0, 12))}`);
+  await nextFrame(page);
+  await shot(page, '11-edit-4-scaled');
+  const [scaledDownload] = await Promise.all([page.waitForEvent('download', { timeout: 30000 }), page.click('#edit-save')]);
+  const scaledSpec = path.join(shotDir, 'armadillo-scaled.edit.json');
+  await scaledDownload.saveAs(scaledSpec);
+  cliMatchesPage(restFile, scaledSpec, (await page.evaluate(() => window.__meshmorph.hooks.editPositions())).raw, diagonal, 'scale');
+  await page.keyboard.press('w');
+  await page.click('#edit-undo');
+  await waitFinalized(page, 5);
 
   // Export the edited mesh as GLB.
   const [glb] = await Promise.all([page.waitForEvent('download', { timeout: 30000 }), page.click('#edit-export')]);
