@@ -7,14 +7,17 @@
 //
 // Usage: node tests/e2e/run.mjs [--headed] [--only <substring>]
 // Env:   MM_CHROMIUM (default /usr/bin/chromium), MM_E2E_BUILD=1 (rebuild the page first),
-//        MM_E2E_OUT (output directory), MM_WASM_DIR (the wasm build, as for vite.config.js)
+//        MM_E2E_OUT (output directory), MM_WASM_DIR (the wasm build, as for vite.config.js),
+//        MM_CLI (the native CLI the edit test compares with; default build/native/native/meshmorph)
 import fs from 'node:fs';
 import net from 'node:net';
 import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { spawnSync } from 'node:child_process';
 import { chromium } from 'playwright-core';
 import { build, preview } from 'vite';
+import { readPlyVertices } from './ply.mjs';
 
 const repoDir = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const configFile = path.join(repoDir, 'web/vite.config.js');
@@ -22,6 +25,7 @@ const distDir = path.join(repoDir, 'build/web-dist');
 const shotDir = path.resolve(process.env.MM_E2E_OUT || path.join(repoDir, 'build/e2e'));
 const args = process.argv.slice(2);
 const only = args.includes('--only') ? args[args.indexOf('--only') + 1] : null;
+const cliPath = path.resolve(repoDir, process.env.MM_CLI || 'build/native/native/meshmorph');
 const background = [0x1d, 0x22, 0x30]; // web/src/view/viewer.js backgroundColor
 
 // ---- helpers
@@ -377,6 +381,276 @@ it('vertex picking: the real mouse over the mesh shows the vertex, a click pins 
   check(await page.isVisible('#pick-pinned'), 'the pinned vertex disappeared when the pointer left the mesh');
   await nextFrame(page);
   await shot(page, '10-pick-pinned');
+});
+
+// ---- the Edit job
+
+// The first of the raw vertices, ordered by `key` (a function body over x, y, z, evaluated in the
+// page), that the camera sees: its index and client position.
+async function visibleVertex(page, key) {
+  return page.evaluate((keySource) => {
+    const score = new Function('x', 'y', 'z', `return ${keySource};`);
+    const p = window.__meshmorph.hooks.editPositions().raw;
+    const order = [...Array(p.length / 3).keys()].sort((a, b) => score(p[3 * b], p[3 * b + 1], p[3 * b + 2]) - score(p[3 * a], p[3 * a + 1], p[3 * a + 2]));
+    for (const v of order.slice(0, 400)) {
+      const s = window.__meshmorph.vertexOnScreen(v);
+      if (s.visible) return { vertex: v, ...s };
+    }
+    return null;
+  }, key);
+}
+
+// A short brush stroke with the real mouse around a client position.
+async function stroke(page, { x, y }) {
+  await page.mouse.move(x, y, { steps: 3 });
+  await page.mouse.down();
+  for (const [dx, dy] of [[6, 0], [6, 6], [0, 6], [-6, 6], [-6, 0], [0, 0]]) await page.mouse.move(x + dx, y + dy, { steps: 2 });
+  await page.mouse.up();
+}
+
+const bboxDiagonal = (p) => {
+  const lo = [Infinity, Infinity, Infinity];
+  const hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < p.length; i += 3) for (let k = 0; k < 3; ++k) { lo[k] = Math.min(lo[k], p[i + k]); hi[k] = Math.max(hi[k], p[i + k]); }
+  return Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+};
+
+// x ↦ M x for a column-major 4x4 M.
+const transformPoint = (m, x, y, z) => [m[0] * x + m[4] * y + m[8] * z + m[12], m[1] * x + m[5] * y + m[9] * z + m[13], m[2] * x + m[6] * y + m[10] * z + m[14]];
+
+const editState = (page) => page.evaluate(() => JSON.parse(JSON.stringify(window.__meshmorph.state.edit)));
+
+async function waitFinalized(page, n) {
+  await page.waitForFunction((k) => window.__meshmorph.state.edit.finalized >= k || window.__meshmorph.state.error, n, { timeout: 30000 });
+  await waitIdle(page);
+  const error = await page.evaluate(() => window.__meshmorph.state.error);
+  check(!error, `edit error: ${JSON.stringify(error)}`);
+}
+
+// Runs `meshmorph edit` on a spec the page saved and compares its vertices with the page's
+// (raw layout, as displayed).
+function cliMatchesPage(meshFile, specFile, pagePositions, diagonal, label) {
+  check(fs.existsSync(cliPath), `the CLI is missing: ${cliPath} (set MM_CLI)`);
+  const out = path.join(shotDir, `${path.basename(specFile, '.json')}-cli.ply`);
+  const run = spawnSync(cliPath, ['edit', meshFile, '--spec', specFile, '--out', out, '--quiet'], { encoding: 'utf8', timeout: 120000 });
+  check(run.status === 0, `meshmorph edit failed (${run.status}): ${run.stderr}`);
+  const cli = readPlyVertices(fs.readFileSync(out));
+  check(cli.length === pagePositions.length, `the CLI wrote ${cli.length / 3} vertices, the page shows ${pagePositions.length / 3}`);
+  let error = 0;
+  const p = pagePositions;
+  for (let i = 0; i < cli.length; i += 3) error = Math.max(error, Math.hypot(cli[i] - p[i], cli[i + 1] - p[i + 1], cli[i + 2] - p[i + 2]));
+  console.log(`     page vs CLI (${label}): max vertex difference ${(error / diagonal).toExponential(2)}·diag`);
+  check(error <= 1e-6 * diagonal, `page and CLI (${label}) differ by ${error / diagonal}·diag`);
+}
+
+it('edit: brush two handles and a fixed part, drag the gizmo, finalize; the saved spec gives the CLI the same mesh', async ({ page, pageErrors }) => {
+  const errorsBefore = pageErrors.length;
+  const restFile = path.join(repoDir, 'data/edit/armadillo.ply');
+  const rest = readPlyVertices(fs.readFileSync(restFile));
+  const diagonal = bboxDiagonal(rest);
+  await pickSample(page, 'armadillo');
+  await page.evaluate(() => { window.__meshmorph.state.error = null; });
+  await page.click('#jobs button[data-job="edit"]');
+  await page.waitForSelector('#edit-select', { state: 'visible' });
+  let edit = await editState(page);
+  check(edit.step === 0 && edit.handle === 0 && !edit.session, `initial edit state ${JSON.stringify(edit)}`);
+  check(/paint/i.test(await page.textContent('.steps li.current')), 'step 1 does not name the next action');
+
+  // Options from the schema: a collapsible section, help as tooltips; one non-default option
+  // goes into the spec (and so to the CLI).
+  await page.click('details.options summary');
+  const optionCount = await page.locator('.option').count();
+  check(optionCount >= 8, `only ${optionCount} options shown`);
+  check((await page.getAttribute('#opt-coherence_rings', 'min')) === '1', 'coherence_rings has no range');
+  check(((await page.locator('.option label').first().getAttribute('title')) || '').length > 10, 'options have no help tooltip');
+  await page.fill('#opt-finalize_refinements', '2');
+  await shot(page, '11-edit-0-options');
+  await page.click('details.options summary');
+
+  // 1: the handle — the brush on the outermost visible vertex of the hand on the right (real
+  // mouse), grown by two rings.
+  await page.click('#edit-brush');
+  const hand = await visibleVertex(page, 'x');
+  check(hand, 'no visible vertex on the right of the mesh');
+  await stroke(page, hand);
+  edit = await editState(page);
+  check(edit.handle > 0, 'the brush stroke selected no handle vertex');
+  const painted = edit.handle;
+  await page.click('#edit-grow');
+  await page.click('#edit-grow');
+  edit = await editState(page);
+  check(edit.handle > painted && edit.step === 1, `grow: ${painted} → ${edit.handle} (step ${edit.step})`);
+  // A second handle on the other hand: it stays where it is while the first one moves.
+  await page.click('#edit-new-handle');
+  const otherHand = await visibleVertex(page, '-x');
+  check(otherHand, 'no visible vertex on the left of the mesh');
+  await page.mouse.move(otherHand.x, otherHand.y, { steps: 3 });
+  check(await page.isVisible('.brush-cursor'), 'no brush cursor over the mesh');
+  await shot(page, '11-edit-1-brush');
+  await stroke(page, otherHand);
+  await page.click('#edit-grow');
+  edit = await editState(page);
+  check(edit.handles.length === 2 && edit.handles[1] > 0 && edit.active === 1, `second handle: ${JSON.stringify(edit.handles)}`);
+  await page.selectOption('#edit-handle', '0');
+  // 2: the fixed part — the lowest visible vertices of both feet, painted holding B (brush off).
+  await page.click('#edit-brush');
+  await page.check('input[name="edit-target"][value="fixed"]');
+  for (const key of ['-y - 0.5 * x', '-y + 0.5 * x']) {
+    const foot = await visibleVertex(page, key);
+    check(foot, `no visible vertex for ${key}`);
+    await page.keyboard.down('b');
+    await stroke(page, foot);
+    await page.keyboard.up('b');
+  }
+  await page.click('#edit-grow');
+  await page.click('#edit-grow');
+  edit = await editState(page);
+  check(edit.fixed > 0, 'the brush selected no fixed vertex');
+  await nextFrame(page);
+  await shot(page, '11-edit-1-selection');
+  check(pixelStats(await canvasPixels(page)).coloured > 0.001, 'the selection is not coloured');
+
+  // 3: start, then drag the gizmo's Y arrow with the real mouse at about 60 moves a second.
+  await page.click('#edit-start');
+  await page.waitForFunction(() => window.__meshmorph.state.edit.session || window.__meshmorph.state.error, null, { timeout: 60000 });
+  await waitIdle(page);
+  edit = await editState(page);
+  check(edit.session && edit.step === 2, `no session: ${JSON.stringify(await page.evaluate(() => window.__meshmorph.state.error))}`);
+  check(edit.spec.options?.finalize_refinements === 2, `options not in the spec: ${JSON.stringify(edit.spec.options)}`);
+  await nextFrame(page);
+  await shot(page, '11-edit-2-gizmo');
+  const arrow = await page.evaluate(() => window.__meshmorph.hooks.editGizmoHandle('Y'));
+  check(arrow && Number.isFinite(arrow.x), 'no gizmo on screen');
+  await page.mouse.move(arrow.x, arrow.y, { steps: 2 });
+  await page.mouse.down();
+  const dragStarted = Date.now();
+  for (let i = 1; i <= 40; ++i) {
+    await page.mouse.move(arrow.x + i, arrow.y - 3 * i);
+    await page.waitForTimeout(16);
+  }
+  const dragMs = Date.now() - dragStarted;
+  await shot(page, '11-edit-3-dragging');
+  await page.mouse.up();
+  await waitFinalized(page, 1);
+  edit = await editState(page);
+  const seconds = (edit.drags.last - edit.drags.first) / 1000;
+  const frameMs = await page.evaluate(async () => {
+    const started = performance.now();
+    for (let i = 0; i < 5; ++i) await window.__meshmorph.nextFrame();
+    return (performance.now() - started) / 5;
+  });
+  console.log(`     drag: 40 mouse moves in ${dragMs} ms → ${edit.drags.sent} editDrag requests, ${edit.drags.answered} answered, `
+    + `${(edit.drags.answered / seconds).toFixed(1)} per second; mean worker round trip ${(edit.drags.roundTripMs / edit.drags.answered).toFixed(1)} ms, `
+    + `geometry update ${(edit.drags.applyMs / edit.drags.answered).toFixed(1)} ms, a rendered frame ${frameMs.toFixed(0)} ms`);
+  check(edit.drags.sent >= 5 && edit.drags.answered === edit.drags.sent, `drag requests ${JSON.stringify(edit.drags)}`);
+  check(edit.step === 3, `step after the drag: ${edit.step}`);
+  const m = edit.matrices[0];
+  const lift = Math.hypot(m[12], m[13], m[14]);
+  check(edit.matrices.length === 2 && edit.matrices[1].every((v, i) => v === [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1][i]), `the second handle moved: ${JSON.stringify(edit.matrices)}`);
+  check(m[13] > 0.05 * diagonal, `the gizmo moved the handle by ${JSON.stringify(m.slice(12, 15))} (diagonal ${diagonal})`);
+  await nextFrame(page);
+  await shot(page, '11-edit-4-finalized');
+
+  // The mesh moved: handle vertices at M·rest, fixed vertices at rest.
+  const { raw, welded } = await page.evaluate(() => window.__meshmorph.hooks.editPositions());
+  const toWelded = await page.evaluate(() => Array.from(window.__meshmorph.state.mesh.toWelded));
+  check(welded && welded.length === rest.length, 'no welded positions after finalize');
+  let handleError = 0;
+  edit.spec.handles.forEach(({ select }, h) => {
+    for (const w of select) {
+      const target = transformPoint(edit.matrices[h], rest[3 * w], rest[3 * w + 1], rest[3 * w + 2]);
+      handleError = Math.max(handleError, Math.hypot(...target.map((t, k) => t - welded[3 * w + k])));
+    }
+  });
+  check(handleError < 1e-5 * diagonal, `handle vertices are ${handleError / diagonal}·diag from their targets`);
+  let fixedError = 0;
+  for (const w of edit.spec.fixed) fixedError = Math.max(fixedError, Math.hypot(...[0, 1, 2].map((k) => rest[3 * w + k] - welded[3 * w + k])));
+  check(fixedError < 1e-5 * diagonal, `fixed vertices moved by ${fixedError / diagonal}·diag`);
+  let moved = 0;
+  for (let i = 0; i < rest.length; i += 3) moved = Math.max(moved, Math.hypot(rest[i] - raw[i], rest[i + 1] - raw[i + 1], rest[i + 2] - raw[i + 2]));
+  check(moved > 0.5 * lift, `largest displacement ${moved}, handle lifted by ${lift}`);
+  for (let r = 0; r < toWelded.length; r += 97) {
+    const w = toWelded[r];
+    check([0, 1, 2].every((k) => raw[3 * r + k] === welded[3 * w + k]), `displayed vertex ${r} differs from welded ${w}`);
+  }
+
+  // 4: save the spec; the CLI on it gives the same vertices.
+  const [specDownload] = await Promise.all([page.waitForEvent('download', { timeout: 30000 }), page.click('#edit-save')]);
+  const specFile = path.join(shotDir, specDownload.suggestedFilename());
+  await specDownload.saveAs(specFile);
+  const spec = JSON.parse(fs.readFileSync(specFile, 'utf8'));
+  check(JSON.stringify(spec.handles.map((h) => h.matrix)) === JSON.stringify(edit.matrices), 'the saved matrices are not the ones the page sent');
+  check(JSON.stringify({ ...spec, handles: spec.handles.map((h) => ({ select: h.select })) }) === JSON.stringify(edit.spec), 'the saved spec differs from the one the page created the session with');
+  cliMatchesPage(restFile, specFile, raw, diagonal, 'translate');
+
+  // Undo goes back to the rest shape, redo to the edit.
+  await page.click('#edit-undo');
+  await waitFinalized(page, 2);
+  const undone = (await page.evaluate(() => window.__meshmorph.hooks.editPositions())).raw;
+  let undoError = 0;
+  for (let i = 0; i < rest.length; ++i) undoError = Math.max(undoError, Math.abs(undone[i] - rest[i]));
+  check(undoError < 1e-5 * diagonal, `undo left the mesh ${undoError / diagonal}·diag from rest`);
+  await page.click('#edit-redo');
+  await waitFinalized(page, 3);
+
+  // Scale mode (key R): stretch handle 1 along its Y axis with the real mouse; the saved spec
+  // (a matrix with a linear part now) again gives the CLI the page's vertices.
+  await page.keyboard.press('r');
+  check(await page.isChecked('input[name="edit-mode"][value="scale"]'), 'the R key did not select the scale gizmo');
+  await nextFrame(page);
+  const scaleY = await page.evaluate(() => window.__meshmorph.hooks.editGizmoHandle('Y'));
+  check(scaleY && Number.isFinite(scaleY.x), 'no scale gizmo on screen');
+  await page.mouse.move(scaleY.x, scaleY.y, { steps: 2 });
+  await page.mouse.down();
+  for (let i = 1; i <= 10; ++i) await page.mouse.move(scaleY.x, scaleY.y - 3 * i);
+  await page.mouse.up();
+  await waitFinalized(page, 4);
+  edit = await editState(page);
+  const scaled = edit.matrices[0];
+  const yScale = Math.hypot(scaled[4], scaled[5], scaled[6]);
+  check(Math.abs(yScale - 1) > 0.05 && Math.abs(Math.hypot(scaled[0], scaled[1], scaled[2]) - 1) < 1e-9, `scale drag gave ${JSON.stringify(scaled.slice(0, 12))}`);
+  await nextFrame(page);
+  await shot(page, '11-edit-4-scaled');
+  const [scaledDownload] = await Promise.all([page.waitForEvent('download', { timeout: 30000 }), page.click('#edit-save')]);
+  const scaledSpec = path.join(shotDir, 'armadillo-scaled.edit.json');
+  await scaledDownload.saveAs(scaledSpec);
+  cliMatchesPage(restFile, scaledSpec, (await page.evaluate(() => window.__meshmorph.hooks.editPositions())).raw, diagonal, 'scale');
+  await page.keyboard.press('w');
+  await page.click('#edit-undo');
+  await waitFinalized(page, 5);
+
+  // Export the edited mesh as GLB.
+  const [glb] = await Promise.all([page.waitForEvent('download', { timeout: 30000 }), page.click('#edit-export')]);
+  const glbFile = path.join(shotDir, glb.suggestedFilename());
+  await glb.saveAs(glbFile);
+  const bytes = fs.readFileSync(glbFile);
+  check(bytes.subarray(0, 4).toString('latin1') === 'glTF' && bytes.readUInt32LE(8) === bytes.length, `bad GLB ${glb.suggestedFilename()}`);
+  const report = await (await import('gltf-validator')).validateBytes(new Uint8Array(bytes));
+  check(report.issues.numErrors === 0, `edited GLB: glTF-Validator: ${JSON.stringify(report.issues.messages.slice(0, 3))}`);
+
+  // Loading the saved spec starts a session and gives the same shape again.
+  await page.click('#edit-stop');
+  await waitIdle(page);
+  await page.setInputFiles('#edit-load', specFile);
+  await page.waitForFunction(() => window.__meshmorph.state.edit.session && window.__meshmorph.state.edit.finalized >= 1 || window.__meshmorph.state.error, null, { timeout: 60000 });
+  await waitIdle(page);
+  check(!(await page.evaluate(() => window.__meshmorph.state.error)), 'loading the spec failed');
+  const reloaded = (await page.evaluate(() => window.__meshmorph.hooks.editPositions())).raw;
+  let reloadError = 0;
+  for (let i = 0; i < raw.length; ++i) reloadError = Math.max(reloadError, Math.abs(reloaded[i] - raw[i]));
+  check(reloadError <= 1e-6 * diagonal, `the loaded spec gives a shape ${reloadError / diagonal}·diag away`);
+  await nextFrame(page);
+  await shot(page, '11-edit-5-loaded-spec');
+  // Other jobs show the loaded mesh; the edit comes back with the Edit tab.
+  await page.click('#jobs button[data-job="mesh"]');
+  const inMesh = (await page.evaluate(() => window.__meshmorph.hooks.editPositions())).raw;
+  check(inMesh.every((v, i) => v === Math.fround(rest[i])), 'the Mesh job shows the edited mesh');
+  await page.click('#jobs button[data-job="edit"]');
+  const back = (await page.evaluate(() => window.__meshmorph.hooks.editPositions())).raw;
+  check(back.every((v, i) => v === reloaded[i]), 'the edit is not shown again in the Edit tab');
+  check(pageErrors.length === errorsBefore, `uncaught page errors: ${pageErrors.slice(errorsBefore).join(' | ')}`);
+  await page.click('#edit-stop');
+  await page.click('#jobs button[data-job="mesh"]');
 });
 
 // ---- runner

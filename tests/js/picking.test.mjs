@@ -114,6 +114,10 @@ test('picks are BVH queries: fast on 50k+ vertices, welded index from the map, r
   const ray = new THREE.Ray(mesh.position.clone().add(new THREE.Vector3(0, 0, 5)), new THREE.Vector3(0, 0, -1));
   const pick = picker.pickRay(ray);
   assert.ok(Math.abs(pick.distance - (5 - 1.1)) < 1e-3, `distance ${pick.distance}`);
+  // refitLater (edit previews): the next pick refits.
+  for (let i = 0; i < position.array.length; ++i) position.array[i] /= 1.1;
+  picker.refitLater();
+  assert.ok(Math.abs(picker.pickRay(ray).distance - 4) < 1e-3, 'the pick after refitLater missed the moved surface');
 
   // A new target drops the BVH.
   const small = new THREE.Mesh(new THREE.BoxGeometry(1, 1, 1), new THREE.MeshBasicMaterial());

@@ -9,6 +9,7 @@ import { MeshMorphClient } from './lib/client.js';
 import { byId } from './ui/dom.js';
 import { panels } from './ui/panels/index.js';
 import { Shell } from './ui/shell.js';
+import { vertexOnScreen } from './view/screen-space.js';
 import { Viewer } from './view/viewer.js';
 
 const params = new URLSearchParams(location.search);
@@ -26,6 +27,9 @@ window.__meshmorph = {
   state: shell.state,
   client,
   get frames() { return viewer.frames; },
+  hooks: shell.hooks,
+  // Where a displayed vertex is: {x, y} in client pixels and whether the camera sees it.
+  vertexOnScreen: (vertex) => vertexOnScreen(viewer, vertex),
   // Resolves once a frame showing the current state has been drawn (tests read pixels then).
   nextFrame: () => new Promise((resolve) => {
     viewer.requestRender();

@@ -8,6 +8,7 @@
 //   app.on(event, fn) / app.emit(event, detail)   events between panels: 'ready' (the worker
 //                 is up), 'mesh' (a mesh was loaded; detail = app.state.mesh), 'job' (switched)
 //   app.showError(e), app.clearError(), app.setStatus(text)
+//   app.hooks     functions for the end-to-end tests (window.__meshmorph.hooks)
 // Controls marked `data-idle` in a panel's markup are disabled while an op runs or the
 // worker is not ready.
 import { toMeshMorphError } from '../lib/errors.js';
@@ -26,6 +27,7 @@ export class Shell {
       busy: null,   // {id, label} of the running request
       error: null,  // {code, message} of the last error shown
     };
+    this.hooks = {};  // functions panels offer the end-to-end tests (window.__meshmorph.hooks)
     this.events = new EventTarget();
     this.panels = []; // {panel, element, job} in registration order
     this.host = byId('panels');

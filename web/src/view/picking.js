@@ -47,6 +47,7 @@ export class VertexPicker {
     this.bvh = null;
     this.bvhGeometry = null;
     this.buildMs = 0;          // time the last BVH build took
+    this.moved = false;        // vertices moved since the BVH was built / refitted
     this.raycaster = new THREE.Raycaster();
     this.inverse = new THREE.Matrix4();
     this.localRay = new THREE.Ray();
@@ -60,22 +61,34 @@ export class VertexPicker {
     this.toWelded = toWelded;
     this.bvh = null;
     this.bvhGeometry = null;
+    this.moved = false;
   }
 
   // The target's vertices moved, its triangles did not (an edit preview): refit the boxes.
   refit() {
+    this.moved = false;
     if (this.bvh && this.bvhGeometry === this.mesh?.geometry) this.bvh.refit();
     else this.bvh = null;
+  }
+
+  // Like refit(), at the next pick: a gizmo drag moves the vertices many times a second and
+  // nobody picks meanwhile.
+  refitLater() {
+    this.moved = true;
   }
 
   // The BVH of the target's current geometry, built on demand.
   ensureBvh() {
     const geometry = this.mesh?.geometry;
     if (!geometry?.getAttribute('position') || !geometry.index) return null;
-    if (this.bvh && this.bvhGeometry === geometry) return this.bvh;
+    if (this.bvh && this.bvhGeometry === geometry) {
+      if (this.moved) this.refit();
+      return this.bvh;
+    }
     const started = performance.now();
     this.bvh = new MeshBVH(geometry, { indirect: true });
     this.bvhGeometry = geometry;
+    this.moved = false;
     this.buildMs = performance.now() - started;
     return this.bvh;
   }

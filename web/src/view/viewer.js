@@ -129,6 +129,15 @@ export class Viewer {
     return marker;
   }
 
+  // New positions for the shown mesh (#R·3, raw layout; same triangles), e.g. an edit preview:
+  // updated in place, normals recomputed, the picking BVH refitted at the next pick.
+  setPositions(positions) {
+    applyArrays(this.geometry, { positions });
+    this.geometry.computeVertexNormals();
+    this.picker.refitLater();
+    this.requestRender();
+  }
+
   // Per-vertex colours (#R·3 in 0..1, raw layout) or null for the plain surface.
   setColors(colors) {
     applyArrays(this.geometry, { colors });
