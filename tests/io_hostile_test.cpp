@@ -11,6 +11,12 @@
 #include "io/gltf_animation.h"
 #include "io/joints_json.h"
 #include "io/json_text.h"
+#include "test_support.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <fstream>
 
 namespace mm {
 namespace {
@@ -205,6 +211,54 @@ TEST(Hostile, TriangleStripsAndFansLoadAsTriangles) {
   j = hostile_gltf(kQuad, {0, 1});
   j["meshes"][0]["primitives"][0]["mode"] = 5;
   EXPECT_EQ(hostile_load(j).status.code, StatusCode::ParseError);
+}
+
+TEST(Hostile, OnlyRegularFilesAreRead) {
+  std::vector<uint8_t> bytes;
+  const std::string dir = test::data_path("edit");
+  Status s = io::read_file(dir, &bytes);
+  EXPECT_EQ(s.code, StatusCode::IoError);
+  EXPECT_NE(s.message.find("a directory"), std::string::npos) << s.message;
+  const std::string dir_ply = test::scratch_path("hostile_dir.ply");
+  ::mkdir(dir_ply.c_str(), 0700);
+  const io::LoadResult r = io::load_asset(dir_ply);
+  EXPECT_EQ(r.status.code, StatusCode::IoError) << r.status.message;
+#ifndef __EMSCRIPTEN__
+  const std::string fifo = test::scratch_path("hostile.fifo.obj");
+  ::unlink(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  s = io::read_file(fifo, &bytes);  // would block forever if opened
+  EXPECT_EQ(s.code, StatusCode::IoError);
+  EXPECT_NE(s.message.find("pipe"), std::string::npos) << s.message;
+  ::unlink(fifo.c_str());
+#endif
+  EXPECT_EQ(io::read_file(test::scratch_path("no_such_file.ply"), &bytes).code, StatusCode::IoError);
+}
+
+TEST(Hostile, WritesAreAtomicAndCheckedFirst) {
+  // Writing onto the input's own path: read, then replace in place.
+  const std::string path = test::scratch_path("hostile_inplace.off");
+  {
+    std::ofstream out(path);
+    out << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  }
+  io::LoadResult r = io::load_asset(path);
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
+  ASSERT_TRUE(io::save_asset(r.asset, r.asset.weld.V * 2.0, path).ok());
+  r = io::load_asset(path);
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
+  EXPECT_DOUBLE_EQ(r.asset.V_raw(1, 0), 2.0);
+  // No temporary file is left next to it.
+  struct stat st;
+  EXPECT_NE(::stat((path + ".mm-tmp-" + std::to_string(::getpid())).c_str(), &st), 0);
+  // A missing folder or a directory as output: clear errors before any work.
+  Status s = io::check_output_path(test::scratch_path("no_such_folder/out.glb"));
+  EXPECT_EQ(s.code, StatusCode::IoError);
+  EXPECT_NE(s.message.find("does not exist"), std::string::npos) << s.message;
+  EXPECT_EQ(io::check_output_path(test::data_path("edit")).code, StatusCode::IoError);
+  EXPECT_TRUE(io::check_output_path(test::scratch_path("fine.glb")).ok());
+  EXPECT_EQ(io::save_asset(r.asset, r.asset.weld.V, test::scratch_path("no_such_folder/out.off")).code,
+            StatusCode::IoError);
 }
 
 }  // namespace
