@@ -11,7 +11,7 @@ import { VertexPicker, ndcFromClient } from './picking.js';
 
 export const sides = ['reference', 'source'];
 const sideColors = { reference: 0xb9c7e0, source: 0xd8cdbf };
-const gap = 0.25; // between the two meshes, in display radii
+const gap = 0.2; // between the two meshes' bounding spheres, in display radii
 
 function createSide(name) {
   const material = new THREE.MeshStandardMaterial({
@@ -81,23 +81,19 @@ export class PairView {
     this.viewer.requestRender();
   }
 
-  // Display size: both sides scaled to bounding radius 1, the reference left of the origin,
-  // the source right of it, centred on their bounding boxes.
+  // Display size: both sides scaled to bounding radius 1 and centred on their bounding boxes,
+  // the reference at x = -(1 + gap / 2), the source at x = +(1 + gap / 2): fixed places, so
+  // switching the source for the result (another extent) does not move the other side.
   layout() {
-    const extent = {};
     for (const side of Object.values(this.sides)) {
       const geometry = side.mesh.geometry;
       if (!side.loaded || !geometry.boundingBox) continue;
       const scale = 1 / (geometry.boundingSphere.radius || 1);
       const center = geometry.boundingBox.getCenter(new THREE.Vector3());
-      const width = (geometry.boundingBox.max.x - geometry.boundingBox.min.x) * scale;
       side.mesh.scale.setScalar(scale);
       side.mesh.position.copy(center).multiplyScalar(-scale);
-      extent[side.name] = width;
+      side.mesh.position.x += (side.name === 'reference' ? -1 : 1) * (1 + gap / 2);
     }
-    const { reference, source } = this.sides;
-    if (reference.loaded) reference.mesh.position.x -= source.loaded ? extent.reference / 2 + gap / 2 : 0;
-    if (source.loaded) source.mesh.position.x += reference.loaded ? extent.source / 2 + gap / 2 : 0;
     this.group.updateMatrixWorld(true);
   }
 

@@ -16,7 +16,7 @@
 // result ({info, metrics, toReference, options}) or null, showing ('source' | 'result'), runs,
 // saved (the last saved landmark file), exports}. Test hooks (window.__meshmorph.hooks):
 // transferVertexOnScreen(side, rawVertex) → {x, y, visible}, transferResult() → welded
-// positions or null, transferShown() → the source side's displayed (raw) positions.
+// positions or null, transferShown(side = 'source') → a side's displayed (raw) positions.
 import { unweldValues } from '../../lib/arrays.js';
 import { LandmarkPairs, landmarkFile, minLandmarks, readLandmarkFile } from '../../lib/landmarks.js';
 import { samples } from '../../lib/samples.js';
@@ -372,6 +372,7 @@ export const panel = {
       transfer.showing = 'result';
       root.querySelector('input[name="tr-show"][value="result"]').checked = true;
       showSource();
+      pair.frame();
       showResultInfo();
       refresh();
       app.setStatus(`transfer (${method}): ${fixed(ran.info.ms.total / 1000, 3)} s`);
@@ -439,7 +440,7 @@ export const panel = {
 
     app.hooks.transferVertexOnScreen = (side, vertex) => vertexOnScreen(viewer, vertex, pair.sides[side]);
     app.hooks.transferResult = () => (result ? Array.from(result) : null);
-    app.hooks.transferShown = () => Array.from(pair.sides.source.mesh.geometry.getAttribute('position').array);
+    app.hooks.transferShown = (side = 'source') => Array.from(pair.sides[side].mesh.geometry.getAttribute('position').array);
     refresh();
     return root;
   },

@@ -5,7 +5,8 @@
 // transfer: options {referenceSlot = 'reference', sourceSlot = 'main', landmarks?: [[r, s], ...],
 //   ...any option of optionSchema {job: 'transfer'} (method, lambda1, lambda2, num_low_frequencies,
 //   num_eigenpairs, num_coupled, mu, cage_vertices, cage_resolution, max_iterations, tolerance,
-//   placement); a missing one is the core's default, an unknown one an InvalidArgument error}
+//   placement); a missing one is the core's default, an unknown one an InvalidArgument error};
+//   buffers {cagePositions?, cageIndices?}: the user's closed cage around the source (default automatic)
 //   → buffers {positions: Float32Array (welded #V·3 of the source), cagePositions, cageIndices}
 //     info {gammaDominance, iterations, converged, couplingIterations, ms, k, gamma: number[]}
 //   Progress messages carry the core's stages (eigenbasis, coupled bases, cage: …,
@@ -30,14 +31,14 @@ function flatLandmarks(pairs) {
 }
 
 export const ops = {
-  transfer(ctx, options = {}) {
+  transfer(ctx, options = {}, buffers = {}) {
     const { referenceSlot = 'reference', sourceSlot = 'main', landmarks, ...jobOptions } = options;
     const reference = meshInSlot(ctx, referenceSlot);
     const source = meshInSlot(ctx, sourceSlot);
     // The job's options go to the binding as given (read_options checks names and ranges).
     const r = unwrap(ctx.module.poseTransfer(reference.weldedPositions, reference.weldedIndices,
       source.weldedPositions, source.weldedIndices, flatLandmarks(landmarks), jobOptions,
-      (stage, fraction) => ctx.progress(stage, fraction)));
+      (stage, fraction) => ctx.progress(stage, fraction), buffers.cagePositions, buffers.cageIndices));
     return {
       buffers: {
         positions: Float32Array.from(r.positions),
