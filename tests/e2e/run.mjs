@@ -771,8 +771,19 @@ it('transfer: the cat pair side by side, run and compare; landmark pairs clicked
   const toWelded = (r) => r; // PLY: displayed = welded (checked below)
   check(t.source.rawVertices === t.source.weldedVertices, 'the cat PLY has seams?');
   check(shown.every((v, i) => v === Math.fround(result[toWelded(i)])), 'the view does not show the result');
+  await page.locator('#tr-metrics').scrollIntoViewIfNeeded();
   await nextFrame(page);
   await shot(page, '12-transfer-3-result');
+
+  // Cancel: a second run stopped from the progress overlay leaves the first result.
+  await page.click('#tr-run');
+  await page.waitForFunction(() => window.__meshmorph.state.busy && document.getElementById('progress-bar').value > 0, null, { timeout: 30000 });
+  await page.click('#cancel');
+  await waitIdle(page, 15000);
+  const cancelled = await page.evaluate(() => window.__meshmorph.state.error);
+  check(cancelled?.code === 'Cancelled', `expected a Cancelled error, got ${JSON.stringify(cancelled)}`);
+  check((await transferState(page)).runs === 1 && (await page.evaluate(() => window.__meshmorph.hooks.transferResult())).every((v, i) => v === result[i]), 'the cancelled run changed the result');
+  await page.click('#error-close');
 
   // Toggle: the source comes back, then the result again.
   await page.check('input[name="tr-show"][value="source"]');

@@ -69,13 +69,13 @@ export class LandmarkMarkers {
   add(side, vertex, rgb, text, big) {
     const view = this.pairView;
     const mesh = view.sides[side].mesh;
-    const radius = view.localRadius(side) * (big ? 0.02 : 0.013);
+    const radius = view.localRadius(side) * (big ? 0.022 : 0.015);
     const marker = new VertexMarker({ color: new THREE.Color(...rgb) });
     marker.setSize(radius);
     marker.show(view.localPoint(side, vertex));
     const sprite = labelSprite(text, rgb);
     sprite.position.copy(marker.object.position);
-    sprite.scale.setScalar(view.localRadius(side) * (big ? 0.09 : 0.07));
+    sprite.scale.setScalar(view.localRadius(side) * (big ? 0.12 : 0.09));
     const object = new THREE.Group();
     object.add(marker.object, sprite);
     mesh.add(object);

@@ -99,7 +99,8 @@ export class PairView {
 
   frame() {
     const meshes = Object.values(this.sides).filter((s) => s.loaded).map((s) => s.mesh);
-    if (meshes.length && this.active) this.viewer.frameMeshes(meshes);
+    // Straight from the front (slightly above): both sides at the same distance, the same size.
+    if (meshes.length && this.active) this.viewer.frameMeshes(meshes, { direction: [0, 0.3, 1] });
   }
 
   // The vertex under a pointer position on either side: the picking.js result plus `side`, or

@@ -173,8 +173,9 @@ export class Viewer {
   }
 
   // The same for several meshes at once (each with its own placement, e.g. two meshes side by
-  // side): the camera looks at the centre of their world-space bounding box.
-  frameMeshes(meshes) {
+  // side): the camera looks at the centre of their world-space bounding box, from `direction`
+  // ([x, y, z], default front right, slightly above).
+  frameMeshes(meshes, { direction: viewDirection = [0.35, 0.25, 1] } = {}) {
     const box = new THREE.Box3();
     for (const mesh of meshes) {
       if (!mesh.geometry.boundingBox) continue;
@@ -186,7 +187,7 @@ export class Viewer {
     if (!(radius > 0)) return;
     const tanY = Math.tan(THREE.MathUtils.degToRad(this.camera.fov) / 2) * 0.85;
     const tanX = tanY * this.camera.aspect;
-    const direction = new THREE.Vector3(0.35, 0.25, 1).normalize();
+    const direction = new THREE.Vector3(...viewDirection).normalize();
     const center = box.getCenter(new THREE.Vector3());
     // Start from the box's sphere distance, then move along the view axis until every vertex
     // is inside the (shrunk) frustum: a point at camera-space (x, y, z) needs depth

@@ -42,13 +42,15 @@ const markup = `
 <section class="transfer">
   <h2>Pose transfer</h2>
   <div id="tr-steps"></div>
-  <div class="row">
-    <label>Reference (pose) <select id="tr-reference-sample" data-idle></select></label>
-    <label class="button file">Open…<input type="file" id="tr-reference-file" multiple accept="${fileTypes}" data-idle /></label>
+  <div class="row side-row">
+    <label for="tr-reference-sample" title="The mesh whose pose is copied (left)">Reference</label>
+    <select id="tr-reference-sample" data-idle></select>
+    <label class="button file" title="Open a reference mesh file">Open…<input type="file" id="tr-reference-file" multiple accept="${fileTypes}" data-idle /></label>
   </div>
-  <div class="row">
-    <label>Source (shape) <select id="tr-source-sample" data-idle></select></label>
-    <label class="button file">Open…<input type="file" id="tr-source-file" multiple accept="${fileTypes}" data-idle /></label>
+  <div class="row side-row">
+    <label for="tr-source-sample" title="The mesh that takes the pose and keeps its details (right)">Source</label>
+    <select id="tr-source-sample" data-idle></select>
+    <label class="button file" title="Open a source mesh file">Open…<input type="file" id="tr-source-file" multiple accept="${fileTypes}" data-idle /></label>
   </div>
   <div class="row">
     <button id="tr-example" type="button" data-idle title="Cat, pose 07 as the reference and the cat's rest pose as the source (same connectivity)">Load the cat example</button>
@@ -67,11 +69,11 @@ const markup = `
   </div>
   <h3>Run</h3>
   <div class="row">
-    <label>Method <select id="tr-method" data-idle>
+    <label for="tr-method">Method</label> <select id="tr-method" data-idle>
       <option value="yin" title="the paper: the source's cage follows the reference's low frequencies">yin (cage, paper 000)</option>
       <option value="kovnatsky" title="coefficient swap in coupled bases (Kovnatsky 2013)">kovnatsky (baseline)</option>
       <option value="levy" title="coefficient swap in plain eigenbases (Lévy 2006)">levy (baseline)</option>
-    </select></label>
+    </select>
     <button id="tr-run" type="button" data-idle>Run transfer</button>
   </div>
   <div id="tr-options"></div>
