@@ -784,6 +784,7 @@ it('transfer: the cat pair side by side, run and compare; landmark pairs clicked
   check(cancelled?.code === 'Cancelled', `expected a Cancelled error, got ${JSON.stringify(cancelled)}`);
   check((await transferState(page)).runs === 1 && (await page.evaluate(() => window.__meshmorph.hooks.transferResult())).every((v, i) => v === result[i]), 'the cancelled run changed the result');
   await page.click('#error-close');
+  await page.evaluate(() => { window.__meshmorph.state.error = null; });
 
   // Toggle: the source comes back, then the result again.
   await page.check('input[name="tr-show"][value="source"]');
@@ -835,6 +836,30 @@ it('transfer: the cat pair side by side, run and compare; landmark pairs clicked
   await page.setInputFiles('#tr-landmarks-load', jsonFile);
   await page.waitForFunction((n) => window.__meshmorph.state.transfer.pairs.length === n, 2, { timeout: 5000 });
   await page.click('#tr-landmarks-clear');
+
+  // Different connectivity (cat → lion): landmarks are needed; the repository's landmark file
+  // (cat-reference indices, valid on cat-07) loads, and the Kovnatsky baseline runs with them.
+  await page.selectOption('#tr-source-sample', 'lion');
+  await page.waitForFunction(() => window.__meshmorph.state.transfer.source?.name === 'lion-reference.ply' || window.__meshmorph.state.error, null, { timeout: 30000 });
+  await waitIdle(page);
+  t = await transferState(page);
+  check(!t.sameConnectivity && t.step === 2 && !t.result, `cat → lion: ${JSON.stringify({ same: t.sameConnectivity, step: t.step })}`);
+  await page.setInputFiles('#tr-landmarks-load', path.join(repoDir, 'data/landmarks/cat-lion.json'));
+  await page.waitForFunction(() => window.__meshmorph.state.transfer.pairs.length === 30 || window.__meshmorph.state.error, null, { timeout: 5000 });
+  check((await transferState(page)).step === 3, 'with 30 loaded pairs the next step is not Run');
+  await page.selectOption('#tr-method', 'kovnatsky');
+  await page.click('#tr-run');
+  await page.waitForFunction(() => window.__meshmorph.state.transfer.runs >= 2 || window.__meshmorph.state.error, null, { timeout: 60000 });
+  await waitIdle(page);
+  check(!(await page.evaluate(() => window.__meshmorph.state.error)), `cat → lion failed: ${JSON.stringify(await page.evaluate(() => window.__meshmorph.state.error))}`);
+  t = await transferState(page);
+  const lion = await page.evaluate(() => window.__meshmorph.hooks.transferResult());
+  check(lion.length === 5000 * 3 && lion.every(Number.isFinite) && t.result.options.landmarks === 30 && t.result.toReference === null,
+    `cat → lion result: ${lion.length / 3} vertices, ${JSON.stringify(t.result.options)}`);
+  await page.locator('#tr-metrics').scrollIntoViewIfNeeded();
+  await nextFrame(page);
+  await shot(page, '12-transfer-6-lion-kovnatsky');
+  await page.selectOption('#tr-method', 'yin');
 
   // Back to the Mesh job: its mesh is shown again.
   await page.click('#jobs button[data-job="mesh"]');
