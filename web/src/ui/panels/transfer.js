@@ -226,6 +226,7 @@ export const panel = {
         restRaw: b.positions.slice(), triangles: weldedTriangles(b.indices, b.toWelded),
       };
       transfer[side] = { name: info.name, rawVertices: info.rawVertices, weldedVertices: info.weldedVertices };
+      app.setStatus(`${side}: ${info.name}, ${info.weldedVertices} vertices, ${info.report.faces} faces · cancel: ${client.cancelMode}`);
       pair.setMesh(side, b, { open: info.report.boundaryLoopLengths.length > 0 || info.report.components === 0 });
       // A new mesh: pairs and results of the old one mean nothing on it.
       landmarks.clear();
