@@ -653,6 +653,221 @@ it('edit: brush two handles and a fixed part, drag the gizmo, finalize; the save
   await page.click('#jobs button[data-job="mesh"]');
 });
 
+// ---- the Transfer job
+
+const transferState = (page) => page.evaluate(() => JSON.parse(JSON.stringify(window.__meshmorph.state.transfer)));
+
+// Up to `count` raw vertices of a side of the Transfer view, ordered by `key` (as in
+// visibleVertex), that the camera sees: index and client position of each.
+async function visibleOnSide(page, side, key, count = 8) {
+  return page.evaluate(({ side: s, keySource, n }) => {
+    const score = new Function('x', 'y', 'z', `return ${keySource};`);
+    const p = window.__meshmorph.hooks.transferShown(s);
+    const order = [...Array(p.length / 3).keys()].sort((a, b) => score(p[3 * b], p[3 * b + 1], p[3 * b + 2]) - score(p[3 * a], p[3 * a + 1], p[3 * a + 2]));
+    const out = [];
+    for (const v of order.slice(0, 600)) {
+      const at = window.__meshmorph.hooks.transferVertexOnScreen(s, v);
+      if (at.visible) out.push({ vertex: v, ...at });
+      if (out.length === n) break;
+    }
+    return out;
+  }, { side, keySource: key, n: count });
+}
+
+// A click with the real mouse at a vertex of a side: the first candidate where the hover pick
+// reports that side (a vertex on the silhouette can let the ray miss). Returns the vertex the
+// page picked (the pending half or the last pair) after checking it is under the pointer
+// (within 3 px).
+async function clickLandmark(page, side, candidates) {
+  const before = await transferState(page);
+  const count = before.pairs.length * 2 + (before.pending ? 1 : 0);
+  for (const target of candidates) {
+    await page.mouse.move(target.x, target.y, { steps: 4 });
+    const hovered = await page.waitForFunction((s) => document.getElementById('tr-hover').textContent.startsWith(s), side, { timeout: 1500 })
+      .then(() => true, () => false);
+    if (!hovered) continue;
+    await page.mouse.down();
+    await page.mouse.up();
+    await page.waitForFunction((n) => {
+      const t = window.__meshmorph.state.transfer;
+      return t.pairs.length * 2 + (t.pending ? 1 : 0) > n;
+    }, count, { timeout: 3000 }).catch(() => { throw new Error(`${side}: the click at vertex ${target.vertex} added no landmark`); });
+    const t = await transferState(page);
+    const picked = t.pending ? t.pending.vertex : t.pairs[t.pairs.length - 1][side === 'reference' ? 0 : 1];
+    const at = await page.evaluate(({ s, v }) => window.__meshmorph.hooks.transferVertexOnScreen(s, v), { s: side, v: picked });
+    check(Math.hypot(at.x - target.x, at.y - target.y) <= 3, `${side}: clicked at vertex ${target.vertex} (${target.x.toFixed(1)}, ${target.y.toFixed(1)}), picked ${picked} at (${at.x.toFixed(1)}, ${at.y.toFixed(1)})`);
+    return picked;
+  }
+  throw new Error(`${side}: no hover pick at any of the vertices ${candidates.map((c) => c.vertex).join(', ')}`);
+}
+
+const meanDistance = (a, b) => {
+  let sum = 0;
+  for (let i = 0; i < a.length; i += 3) sum += Math.hypot(a[i] - b[i], a[i + 1] - b[i + 1], a[i + 2] - b[i + 2]);
+  return sum / (a.length / 3);
+};
+
+it('transfer: the cat pair side by side, run and compare; landmark pairs clicked with the real mouse, saved as JSON', async ({ page, pageErrors }) => {
+  const errorsBefore = pageErrors.length;
+  const reference = readPlyVertices(fs.readFileSync(path.join(repoDir, 'data/pose/cat-07.ply')));
+  const source = readPlyVertices(fs.readFileSync(path.join(repoDir, 'data/pose/cat-reference.ply')));
+  await loadCount(page);
+  await page.evaluate(() => { window.__meshmorph.state.error = null; });
+  await page.click('#jobs button[data-job="transfer"]');
+  await page.waitForSelector('#tr-steps', { state: 'visible' });
+  let t = await transferState(page);
+  check(t.step === 0 && !t.reference, `initial transfer state ${JSON.stringify(t)}`);
+
+  // 1, 2: the reference (cat, pose 07) and the source (the cat at rest): same connectivity.
+  await page.selectOption('#tr-reference-sample', 'cat-07');
+  await page.waitForFunction(() => window.__meshmorph.state.transfer.reference || window.__meshmorph.state.error, null, { timeout: 30000 });
+  await waitIdle(page);
+  t = await transferState(page);
+  check(t.reference?.name === 'cat-07.ply' && t.step === 1, `after the reference: ${JSON.stringify({ reference: t.reference, step: t.step })}`);
+  await page.selectOption('#tr-source-sample', 'cat');
+  await page.waitForFunction(() => window.__meshmorph.state.transfer.source || window.__meshmorph.state.error, null, { timeout: 30000 });
+  await waitIdle(page);
+  t = await transferState(page);
+  check(t.source?.name === 'cat-reference.ply' && t.sameConnectivity && t.step === 3, `after the source: ${JSON.stringify({ source: t.source, same: t.sameConnectivity, step: t.step })}`);
+  check(/generated automatically/.test(await page.textContent('#tr-landmark-hint')), 'the panel does not say that landmarks are generated');
+  await nextFrame(page);
+  const pairPixels = await canvasPixels(page);
+  // Both meshes: foreground in the left and in the right third of the view.
+  const thirds = [0, 0, 0];
+  for (let y = 0; y < pairPixels.h; ++y) {
+    for (let x = 0; x < pairPixels.w; ++x) {
+      const i = 4 * (y * pairPixels.w + x);
+      const d = Math.abs(pairPixels.data[i] - background[0]) + Math.abs(pairPixels.data[i + 1] - background[1]) + Math.abs(pairPixels.data[i + 2] - background[2]);
+      if (d > 30) thirds[Math.min(2, Math.floor((3 * x) / pairPixels.w))] += 1;
+    }
+  }
+  await shot(page, '12-transfer-1-pair');
+  check(thirds[0] > 100 && thirds[2] > 100, `the two meshes are not side by side (foreground pixels per third ${thirds})`);
+
+  // 4: run with the default method (yin), generated landmarks.
+  await page.click('#tr-run');
+  await page.waitForFunction(() => window.__meshmorph.state.busy, null, { timeout: 10000 }).catch(() => {});
+  await shot(page, '12-transfer-2-running');
+  await page.waitForFunction(() => window.__meshmorph.state.transfer.runs >= 1 || window.__meshmorph.state.error, null, { timeout: 60000 });
+  await waitIdle(page);
+  check(!(await page.evaluate(() => window.__meshmorph.state.error)), `transfer failed: ${JSON.stringify(await page.evaluate(() => window.__meshmorph.state.error))}`);
+  t = await transferState(page);
+  const result = await page.evaluate(() => window.__meshmorph.hooks.transferResult());
+  check(result.length === source.length && result.every(Number.isFinite), `result has ${result.length / 3} vertices, the source ${source.length / 3}`);
+  const diagonal = bboxDiagonal(reference);
+  const moved = meanDistance(result, source) / diagonal;
+  const resultToReference = meanDistance(result, reference) / diagonal;
+  const sourceToReference = meanDistance(source, reference) / diagonal;
+  console.log(`     transfer: ${t.result.info.ms.total.toFixed(0)} ms; mean distance to the reference ${resultToReference.toFixed(3)}·diag (source ${sourceToReference.toFixed(3)}), moved ${moved.toFixed(3)}·diag; `
+    + `Γ dominance ${t.result.info.gammaDominance.toFixed(2)}, ${t.result.metrics.flippedFaces} flipped faces, detail change ${t.result.metrics.laplacianChange.toFixed(3)}`);
+  check(moved > 0.01, `the result is the source (moved ${moved}·diag)`);
+  check(resultToReference < 0.6 * sourceToReference, `the result is not closer to the reference: ${resultToReference} against the source's ${sourceToReference}`);
+  check(Math.abs(t.result.toReference.vertexErrorMean - resultToReference) < 0.1 * resultToReference, `compare op says ${t.result.toReference.vertexErrorMean}, node ${resultToReference}`);
+  check(t.step === 4 && t.result.info.k > 0 && t.result.info.gamma.length === t.result.info.k ** 2 && Number.isFinite(t.result.info.gammaDominance), `result info ${JSON.stringify(t.result.info).slice(0, 300)}`);
+  check(Number.isInteger(t.result.metrics.flippedFaces) && Number.isFinite(t.result.metrics.laplacianChange), `metrics ${JSON.stringify(t.result.metrics)}`);
+  check(await page.isVisible('canvas.gamma-map'), 'no Γ heat map');
+  check((await page.textContent('#tr-metrics')).includes('flipped faces'), 'metrics not shown');
+  const shown = await page.evaluate(() => window.__meshmorph.hooks.transferShown());
+  const toWelded = (r) => r; // PLY: displayed = welded (checked below)
+  check(t.source.rawVertices === t.source.weldedVertices, 'the cat PLY has seams?');
+  check(shown.every((v, i) => v === Math.fround(result[toWelded(i)])), 'the view does not show the result');
+  await page.locator('#tr-metrics').scrollIntoViewIfNeeded();
+  await nextFrame(page);
+  await shot(page, '12-transfer-3-result');
+
+  // Cancel: a second run stopped from the progress overlay leaves the first result.
+  await page.click('#tr-run');
+  await page.waitForFunction(() => window.__meshmorph.state.busy && document.getElementById('progress-bar').value > 0, null, { timeout: 30000 });
+  await page.click('#cancel');
+  await waitIdle(page, 15000);
+  const cancelled = await page.evaluate(() => window.__meshmorph.state.error);
+  check(cancelled?.code === 'Cancelled', `expected a Cancelled error, got ${JSON.stringify(cancelled)}`);
+  check((await transferState(page)).runs === 1 && (await page.evaluate(() => window.__meshmorph.hooks.transferResult())).every((v, i) => v === result[i]), 'the cancelled run changed the result');
+  await page.click('#error-close');
+  await page.evaluate(() => { window.__meshmorph.state.error = null; });
+
+  // Toggle: the source comes back, then the result again.
+  await page.check('input[name="tr-show"][value="source"]');
+  const back = await page.evaluate(() => window.__meshmorph.hooks.transferShown());
+  check(back.every((v, i) => v === Math.fround(source[i])), 'Source does not show the source');
+
+  // 5: export the result as GLB.
+  const [glb] = await Promise.all([page.waitForEvent('download', { timeout: 30000 }), page.click('#tr-export')]);
+  const glbFile = path.join(shotDir, glb.suggestedFilename());
+  await glb.saveAs(glbFile);
+  const bytes = fs.readFileSync(glbFile);
+  check(glb.suggestedFilename() === 'cat-reference-posed.glb' && bytes.subarray(0, 4).toString('latin1') === 'glTF', `bad GLB ${glb.suggestedFilename()}`);
+  const report = await (await import('gltf-validator')).validateBytes(new Uint8Array(bytes));
+  check(report.issues.numErrors === 0, `posed GLB: glTF-Validator: ${JSON.stringify(report.issues.messages.slice(0, 3))}`);
+
+  // 3: landmark pairs with the real mouse: on each side the vertex furthest towards the
+  // upper front, the right front and the left front (facing the camera, away from the
+  // silhouette, where a ray through the vertex could miss the surface).
+  const clicked = [];
+  for (const key of ['y + z', 'x + z', '-x + z']) {
+    const r = await clickLandmark(page, 'reference', await visibleOnSide(page, 'reference', key));
+    const s = await clickLandmark(page, 'source', await visibleOnSide(page, 'source', key));
+    clicked.push([r, s]);
+    if (clicked.length === 1) await shot(page, '12-transfer-4-first-pair');
+  }
+  t = await transferState(page);
+  check(JSON.stringify(t.pairs) === JSON.stringify(clicked) && !t.pending, `pairs ${JSON.stringify(t.pairs)}, clicked ${JSON.stringify(clicked)}`);
+  check(t.step === 2, `with 3 pairs (fewer than 6) the step is ${t.step}`);
+  check(await page.locator('table.landmarks tbody tr').count() === 3, 'the table does not list 3 pairs');
+  // Select pair 2 in the table, then delete pair 3.
+  await page.click('table.landmarks tbody tr[data-index="1"]');
+  check((await transferState(page)).selected === 1, 'a click on the row did not select the pair');
+  await nextFrame(page);
+  await shot(page, '12-transfer-5-landmarks');
+  await page.click('table.landmarks tbody tr[data-index="2"] .pair-delete');
+  t = await transferState(page);
+  check(JSON.stringify(t.pairs) === JSON.stringify(clicked.slice(0, 2)), `after deleting pair 3: ${JSON.stringify(t.pairs)}`);
+
+  // Save the landmark JSON (the CLI's format).
+  const [json] = await Promise.all([page.waitForEvent('download', { timeout: 30000 }), page.click('#tr-landmarks-save')]);
+  const jsonFile = path.join(shotDir, json.suggestedFilename());
+  await json.saveAs(jsonFile);
+  const saved = JSON.parse(fs.readFileSync(jsonFile, 'utf8'));
+  check(json.suggestedFilename() === 'cat-07-cat-reference.json', `landmark file name ${json.suggestedFilename()}`);
+  check(saved.reference === 'cat-07.ply' && saved.source === 'cat-reference.ply' && JSON.stringify(saved.pairs) === JSON.stringify(clicked.slice(0, 2)), `saved ${JSON.stringify(saved)}`);
+  // Load it back after clearing.
+  await page.click('#tr-landmarks-clear');
+  check((await transferState(page)).pairs.length === 0, 'Clear left pairs');
+  await page.setInputFiles('#tr-landmarks-load', jsonFile);
+  await page.waitForFunction((n) => window.__meshmorph.state.transfer.pairs.length === n, 2, { timeout: 5000 });
+  await page.click('#tr-landmarks-clear');
+
+  // Different connectivity (cat → lion): landmarks are needed; the repository's landmark file
+  // (cat-reference indices, valid on cat-07) loads, and the Kovnatsky baseline runs with them.
+  await page.selectOption('#tr-source-sample', 'lion');
+  await page.waitForFunction(() => window.__meshmorph.state.transfer.source?.name === 'lion-reference.ply' || window.__meshmorph.state.error, null, { timeout: 30000 });
+  await waitIdle(page);
+  t = await transferState(page);
+  check(!t.sameConnectivity && t.step === 2 && !t.result, `cat → lion: ${JSON.stringify({ same: t.sameConnectivity, step: t.step })}`);
+  await page.setInputFiles('#tr-landmarks-load', path.join(repoDir, 'data/landmarks/cat-lion.json'));
+  await page.waitForFunction(() => window.__meshmorph.state.transfer.pairs.length === 30 || window.__meshmorph.state.error, null, { timeout: 5000 });
+  check((await transferState(page)).step === 3, 'with 30 loaded pairs the next step is not Run');
+  await page.selectOption('#tr-method', 'kovnatsky');
+  await page.click('#tr-run');
+  await page.waitForFunction(() => window.__meshmorph.state.transfer.runs >= 2 || window.__meshmorph.state.error, null, { timeout: 60000 });
+  await waitIdle(page);
+  check(!(await page.evaluate(() => window.__meshmorph.state.error)), `cat → lion failed: ${JSON.stringify(await page.evaluate(() => window.__meshmorph.state.error))}`);
+  t = await transferState(page);
+  const lion = await page.evaluate(() => window.__meshmorph.hooks.transferResult());
+  check(lion.length === 5000 * 3 && lion.every(Number.isFinite) && t.result.options.landmarks === 30 && t.result.toReference === null,
+    `cat → lion result: ${lion.length / 3} vertices, ${JSON.stringify(t.result.options)}`);
+  await page.locator('#tr-metrics').scrollIntoViewIfNeeded();
+  await nextFrame(page);
+  await shot(page, '12-transfer-6-lion-kovnatsky');
+  await page.selectOption('#tr-method', 'yin');
+
+  // Back to the Mesh job: its mesh is shown again.
+  await page.click('#jobs button[data-job="mesh"]');
+  await nextFrame(page);
+  check(pixelStats(await canvasPixels(page)).foreground > 0.02, 'the Mesh job shows nothing after the Transfer job');
+  check(pageErrors.length === errorsBefore, `uncaught page errors: ${pageErrors.slice(errorsBefore).join(' | ')}`);
+});
+
 // ---- runner
 
 // True when build/web-dist is missing or older than the page sources or the wasm module.

@@ -1,7 +1,9 @@
 // Mesh vertices on the screen: projection of the displayed (raw) vertices to client pixel
 // coordinates, and whether a vertex is visible (not hidden behind another part of the surface:
 // a BVH ray cast from the camera, view/picking.js's BVH). Used by the selection brush and by
-// the end-to-end tests, which point the real mouse at vertices.
+// the end-to-end tests, which point the real mouse at vertices. vertexVisible / vertexOnScreen
+// take an optional target {mesh, picker} (default: the viewer's mesh and picker), e.g. one of
+// the two meshes of view/pair-view.js.
 import * as THREE from 'three';
 
 const v = new THREE.Vector3();
@@ -33,10 +35,10 @@ export function projectVertices(viewer) {
 
 // True when the raw vertex is the first surface point the camera sees along its line of sight
 // (within a small tolerance of the scene's size).
-export function vertexVisible(viewer, vertex) {
-  const bvh = viewer.picker.ensureBvh();
+export function vertexVisible(viewer, vertex, { mesh = viewer.mesh, picker = viewer.picker } = {}) {
+  const bvh = picker.ensureBvh();
   if (!bvh) return false;
-  const { camera, mesh } = viewer;
+  const { camera } = viewer;
   const p = mesh.geometry.getAttribute('position').array;
   mesh.updateMatrixWorld();
   inverse.copy(mesh.matrixWorld).invert();
@@ -54,8 +56,9 @@ export function vertexVisible(viewer, vertex) {
 
 // Where a raw vertex is on the screen: {x, y} in client pixels, visible (in the view and not
 // hidden by the surface).
-export function vertexOnScreen(viewer, vertex) {
-  const { camera, mesh } = viewer;
+export function vertexOnScreen(viewer, vertex, target = {}) {
+  const { camera } = viewer;
+  const mesh = target.mesh ?? viewer.mesh;
   const rect = viewer.renderer.domElement.getBoundingClientRect();
   camera.updateMatrixWorld();
   const world = new THREE.Vector3().fromBufferAttribute(mesh.geometry.getAttribute('position'), vertex).applyMatrix4(mesh.matrixWorld);
@@ -63,5 +66,5 @@ export function vertexOnScreen(viewer, vertex) {
   const x = rect.left + ((ndc.x + 1) / 2) * rect.width;
   const y = rect.top + ((1 - ndc.y) / 2) * rect.height;
   const inView = Math.abs(ndc.x) < 1 && Math.abs(ndc.y) < 1 && Math.abs(ndc.z) < 1;
-  return { x, y, visible: inView && vertexVisible(viewer, vertex) };
+  return { x, y, visible: inView && mesh.visible && vertexVisible(viewer, vertex, { mesh, picker: target.picker ?? viewer.picker }) };
 }

@@ -112,9 +112,9 @@ export class Viewer {
   }
 
   // The vertex under a pointer position (clientX/clientY, as in mouse events) or null; see
-  // picking.js for the result.
+  // picking.js for the result. Null while the mesh is hidden (setMainVisible).
   pickAt(clientX, clientY) {
-    if (!this.geometry.getAttribute('position')) return null;
+    if (!this.geometry.getAttribute('position') || !this.mesh.visible) return null;
     const [x, y] = ndcFromClient(clientX, clientY, this.renderer.domElement.getBoundingClientRect());
     this.camera.updateMatrixWorld();
     return this.picker.pickNdc(x, y, this.camera);
@@ -151,7 +151,17 @@ export class Viewer {
   }
 
   setWireframe(on) {
-    this.wire.visible = on;
+    this.wireframe = on;
+    this.wire.visible = on && this.mesh.visible;
+    this.requestRender();
+  }
+
+  // Shows or hides the loaded mesh, its wireframe and the overlays (markers): a job that shows
+  // other meshes in the scene (ui/panels/transfer.js) hides them while it is shown.
+  setMainVisible(on) {
+    this.mesh.visible = on;
+    this.wire.visible = on && Boolean(this.wireframe);
+    this.overlays.visible = on;
     this.requestRender();
   }
 
@@ -159,29 +169,46 @@ export class Viewer {
   // the narrower side of the view. The fit uses the vertices themselves: a bounding sphere or
   // box seen obliquely frames most shapes far too small.
   frame() {
-    const sphere = this.geometry.boundingSphere;
-    const box = this.geometry.boundingBox;
-    if (!sphere || !(sphere.radius > 0)) return;
+    this.frameMeshes([this.mesh]);
+  }
+
+  // The same for several meshes at once (each with its own placement, e.g. two meshes side by
+  // side): the camera looks at the centre of their world-space bounding box, from `direction`
+  // ([x, y, z], default front right, slightly above).
+  frameMeshes(meshes, { direction: viewDirection = [0.35, 0.25, 1] } = {}) {
+    const box = new THREE.Box3();
+    for (const mesh of meshes) {
+      if (!mesh.geometry.boundingBox) continue;
+      mesh.updateMatrixWorld();
+      box.union(mesh.geometry.boundingBox.clone().applyMatrix4(mesh.matrixWorld));
+    }
+    if (box.isEmpty()) return;
+    const radius = box.getSize(new THREE.Vector3()).length() / 2;
+    if (!(radius > 0)) return;
     const tanY = Math.tan(THREE.MathUtils.degToRad(this.camera.fov) / 2) * 0.85;
     const tanX = tanY * this.camera.aspect;
-    const direction = new THREE.Vector3(0.35, 0.25, 1).normalize();
+    const direction = new THREE.Vector3(...viewDirection).normalize();
     const center = box.getCenter(new THREE.Vector3());
-    // Start from the sphere's distance, then move along the view axis until every vertex is
-    // inside the (shrunk) frustum: a point at camera-space (x, y, z) needs depth
+    // Start from the box's sphere distance, then move along the view axis until every vertex
+    // is inside the (shrunk) frustum: a point at camera-space (x, y, z) needs depth
     // max(|x|/tanX, |y|/tanY), and moving back by Δ adds Δ to every depth.
-    let distance = sphere.radius / Math.sin(Math.atan(Math.min(tanX, tanY)));
+    let distance = radius / Math.sin(Math.atan(Math.min(tanX, tanY)));
     this.camera.position.copy(center).addScaledVector(direction, distance);
     this.camera.lookAt(center);
     this.camera.updateMatrixWorld();
-    const m = this.camera.matrixWorldInverse.elements;
-    const p = this.geometry.getAttribute('position').array;
     let shift = -Infinity;
-    for (let i = 0; i < p.length; i += 3) {
-      const x = m[0] * p[i] + m[4] * p[i + 1] + m[8] * p[i + 2] + m[12];
-      const y = m[1] * p[i] + m[5] * p[i + 1] + m[9] * p[i + 2] + m[13];
-      const z = m[2] * p[i] + m[6] * p[i + 1] + m[10] * p[i + 2] + m[14];
-      const need = Math.max(Math.abs(x) / tanX, Math.abs(y) / tanY) + z;
-      if (need > shift) shift = need;
+    for (const mesh of meshes) {
+      const position = mesh.geometry.getAttribute('position');
+      if (!position) continue;
+      const m = new THREE.Matrix4().multiplyMatrices(this.camera.matrixWorldInverse, mesh.matrixWorld).elements;
+      const p = position.array;
+      for (let i = 0; i < p.length; i += 3) {
+        const x = m[0] * p[i] + m[4] * p[i + 1] + m[8] * p[i + 2] + m[12];
+        const y = m[1] * p[i] + m[5] * p[i + 1] + m[9] * p[i + 2] + m[13];
+        const z = m[2] * p[i] + m[6] * p[i + 1] + m[10] * p[i + 2] + m[14];
+        const need = Math.max(Math.abs(x) / tanX, Math.abs(y) / tanY) + z;
+        if (need > shift) shift = need;
+      }
     }
     distance += shift;
     // Clip planes and zoom range follow the mesh's scale (files come in mm or in m).

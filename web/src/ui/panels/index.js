@@ -4,5 +4,6 @@ import { panel as edit } from './edit.js';
 import { panel as eigen } from './eigen.js';
 import { panel as info } from './info.js';
 import { panel as mesh } from './mesh.js';
+import { panel as transfer } from './transfer.js';
 
-export const panels = [mesh, eigen, info, edit];
+export const panels = [mesh, eigen, info, edit, transfer];

@@ -3,13 +3,16 @@
 // worker/ops/index.js like every ops file.
 //
 // transfer: options {referenceSlot = 'reference', sourceSlot = 'main', landmarks?: [[r, s], ...],
-//   method?: 'yin'|'kovnatsky'|'levy', lambda1?, lambda2?, num_low_frequencies?, num_eigenpairs?,
-//   cage_vertices?, cage_resolution?, max_iterations?, placement?: 'reference'|'source'}
+//   ...any option of optionSchema {job: 'transfer'} (method, lambda1, lambda2, num_low_frequencies,
+//   num_eigenpairs, num_coupled, mu, cage_vertices, cage_resolution, max_iterations, tolerance,
+//   placement); a missing one is the core's default, an unknown one an InvalidArgument error};
+//   buffers {cagePositions?, cageIndices?}: the user's closed cage around the source (default automatic)
 //   → buffers {positions: Float32Array (welded #V·3 of the source), cagePositions, cageIndices}
 //     info {gammaDominance, iterations, converged, couplingIterations, ms, k, gamma: number[]}
 //   Progress messages carry the core's stages (eigenbasis, coupled bases, cage: …,
 //   mean-value coordinates, optimisation); returning false from ctx.progress cancels.
-// compare: options {slotA = 'main', slotB = 'reference'} (same vertex order)
+// compare: options {slotA = 'main', slotB = 'reference'} (same vertex order); buffers
+//   {positionsA?: welded #V·3} compares those positions (e.g. a transfer result) instead of slotA's
 //   → info {vertexErrorMean, vertexErrorMax, laplacianChange, edgeDistortionMean,
 //           edgeDistortionMax, flippedFaces}
 import { MeshMorphError, unwrap } from '../../lib/errors.js';
@@ -28,16 +31,14 @@ function flatLandmarks(pairs) {
 }
 
 export const ops = {
-  transfer(ctx, options = {}) {
-    const reference = meshInSlot(ctx, options.referenceSlot || 'reference');
-    const source = meshInSlot(ctx, options.sourceSlot || 'main');
+  transfer(ctx, options = {}, buffers = {}) {
+    const { referenceSlot = 'reference', sourceSlot = 'main', landmarks, ...jobOptions } = options;
+    const reference = meshInSlot(ctx, referenceSlot);
+    const source = meshInSlot(ctx, sourceSlot);
+    // The job's options go to the binding as given (read_options checks names and ranges).
     const r = unwrap(ctx.module.poseTransfer(reference.weldedPositions, reference.weldedIndices,
-      source.weldedPositions, source.weldedIndices, flatLandmarks(options.landmarks), {
-        method: options.method, lambda1: options.lambda1, lambda2: options.lambda2,
-        num_low_frequencies: options.num_low_frequencies, num_eigenpairs: options.num_eigenpairs,
-        cage_vertices: options.cage_vertices, cage_resolution: options.cage_resolution,
-        max_iterations: options.max_iterations, placement: options.placement,
-      }, (stage, fraction) => ctx.progress(stage, fraction)));
+      source.weldedPositions, source.weldedIndices, flatLandmarks(landmarks), jobOptions,
+      (stage, fraction) => ctx.progress(stage, fraction), buffers.cagePositions, buffers.cageIndices));
     return {
       buffers: {
         positions: Float32Array.from(r.positions),
@@ -51,10 +52,13 @@ export const ops = {
     };
   },
 
-  compare(ctx, options = {}) {
-    const a = meshInSlot(ctx, options.slotA || 'main');
+  compare(ctx, options = {}, buffers = {}) {
     const b = meshInSlot(ctx, options.slotB || 'reference');
-    const r = unwrap(ctx.module.transferMetrics(a.weldedPositions, b.weldedPositions, b.weldedIndices));
+    const positionsA = buffers.positionsA ?? meshInSlot(ctx, options.slotA || 'main').weldedPositions;
+    if (positionsA.length !== b.weldedPositions.length) {
+      throw new MeshMorphError('InvalidArgument', `compare: ${positionsA.length / 3} and ${b.weldedPositions.length / 3} vertices (the meshes must share the vertex order)`);
+    }
+    const r = unwrap(ctx.module.transferMetrics(positionsA, b.weldedPositions, b.weldedIndices));
     const { ok, ...info } = r;
     return { buffers: {}, info };
   },

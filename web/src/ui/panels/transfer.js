@@ -1,0 +1,450 @@
+// The Transfer job: give a source mesh the pose of a reference mesh (spectral pose transfer,
+// docs/transfer.md; worker ops `transfer` and `compare` in worker/ops/transfer.js). A guided
+// step list leads through
+//   1 load the reference (pose) mesh   2 load the source (shape) mesh
+//   3 landmark pairs — needed when the connectivity differs (same vertex count and faces: the
+//     core generates 30 pairs itself): click a vertex on the reference, then its match on the
+//     source; pairs are numbered and colour-matched on both meshes and listed in a table
+//     (select, delete); save / load as the CLI's landmark JSON (welded indices)
+//   4 run (method yin / kovnatsky / levy, options from optionSchema {job: 'transfer'})
+//   5 compare (Γ dominance, Γ heat map, flipped faces and detail change from `compare`, result
+//     against source) and export the result as GLB (the source's asset with the new positions).
+// Both meshes are shown side by side (view/pair-view.js) while the job is shown; the Mesh and
+// Edit jobs keep their own mesh. The meshes live in their own worker slots (slots below).
+// State it owns (window.__meshmorph.state.transfer): {step, reference, source ({name,
+// rawVertices, weldedVertices} or null), sameConnectivity, pairs, pending, selected, method,
+// result ({info, metrics, toReference, options}) or null, showing ('source' | 'result'), runs,
+// saved (the last saved landmark file), exports}. Test hooks (window.__meshmorph.hooks):
+// transferVertexOnScreen(side, rawVertex) → {x, y, visible}, transferResult() → welded
+// positions or null, transferShown(side = 'source') → a side's displayed (raw) positions.
+import { unweldValues } from '../../lib/arrays.js';
+import { LandmarkPairs, landmarkFile, minLandmarks, readLandmarkFile } from '../../lib/landmarks.js';
+import { samples } from '../../lib/samples.js';
+import { weldedTriangles } from '../../lib/vertex-sets.js';
+import { LandmarkMarkers } from '../../view/landmark-markers.js';
+import { VertexMarker } from '../../view/marker.js';
+import { PairView } from '../../view/pair-view.js';
+import { attachPointerPicking } from '../../view/pointer-picking.js';
+import { vertexOnScreen } from '../../view/screen-space.js';
+import { download } from '../download.js';
+import { finder, fromHtml } from '../dom.js';
+import { sampleFiles, userFiles } from '../files.js';
+import { GammaMap } from '../gamma-map.js';
+import { LandmarkTable } from '../landmark-table.js';
+import { OptionsForm } from '../options-form.js';
+import { StepList } from '../step-list.js';
+
+const slots = { reference: 'transfer-reference', source: 'transfer-source' };
+const example = { reference: 'cat-07', source: 'cat' }; // same connectivity (docs/transfer.md)
+const fileTypes = '.glb,.gltf,.bin,.obj,.off,.ply,.png,.jpg,.jpeg,.webp';
+
+const markup = `
+<section class="transfer">
+  <h2>Pose transfer</h2>
+  <div id="tr-steps"></div>
+  <div class="row side-row">
+    <label for="tr-reference-sample" title="The mesh whose pose is copied (left)">Reference</label>
+    <select id="tr-reference-sample" data-idle></select>
+    <label class="button file" title="Open a reference mesh file">Open…<input type="file" id="tr-reference-file" multiple accept="${fileTypes}" data-idle /></label>
+  </div>
+  <div class="row side-row">
+    <label for="tr-source-sample" title="The mesh that takes the pose and keeps its details (right)">Source</label>
+    <select id="tr-source-sample" data-idle></select>
+    <label class="button file" title="Open a source mesh file">Open…<input type="file" id="tr-source-file" multiple accept="${fileTypes}" data-idle /></label>
+  </div>
+  <div class="row">
+    <button id="tr-example" type="button" data-idle title="Cat, pose 07 as the reference and the cat's rest pose as the source (same connectivity)">Load the cat example</button>
+  </div>
+  <p id="tr-meshes" class="hint"></p>
+  <h3>Landmarks</h3>
+  <p id="tr-landmark-hint" class="hint"></p>
+  <p id="tr-hover" class="pick-hover"></p>
+  <div id="tr-table"></div>
+  <div class="row">
+    <button id="tr-landmarks-clear" type="button" title="Delete every pair">Clear</button>
+    <button id="tr-landmarks-save" type="button" title="The pairs as the CLI's landmark JSON (meshmorph transfer --landmarks)">Save JSON</button>
+    <label class="button file" title="Open a landmark JSON {&quot;pairs&quot;: [[reference, source], ...]}">Load JSON…
+      <input type="file" id="tr-landmarks-load" accept=".json,application/json" data-idle />
+    </label>
+  </div>
+  <h3>Run</h3>
+  <div class="row">
+    <label for="tr-method">Method</label> <select id="tr-method" data-idle>
+      <option value="yin" title="the paper: the source's cage follows the reference's low frequencies">yin (cage, paper 000)</option>
+      <option value="kovnatsky" title="coefficient swap in coupled bases (Kovnatsky 2013)">kovnatsky (baseline)</option>
+      <option value="levy" title="coefficient swap in plain eigenbases (Lévy 2006)">levy (baseline)</option>
+    </select>
+    <button id="tr-run" type="button" data-idle>Run transfer</button>
+  </div>
+  <div id="tr-options"></div>
+  <div id="tr-result" hidden>
+    <h3>Result</h3>
+    <div class="row" role="radiogroup" aria-label="Show">
+      <label><input type="radio" name="tr-show" value="source" /> Source</label>
+      <label><input type="radio" name="tr-show" value="result" checked /> Result</label>
+      <button id="tr-export" type="button" data-idle>Export GLB</button>
+    </div>
+    <div class="gamma-row">
+      <div id="tr-gamma"></div>
+      <dl id="tr-metrics" class="metrics"></dl>
+    </div>
+  </div>
+</section>`;
+
+// First raw vertex of every welded vertex (markers are placed on displayed vertices).
+function weldedToRaw(toWelded, count) {
+  const out = new Int32Array(count).fill(-1);
+  for (let r = toWelded.length - 1; r >= 0; --r) out[toWelded[r]] = r;
+  return out;
+}
+
+const sameArrays = (a, b) => a.length === b.length && a.every((v, i) => v === b[i]);
+const fixed = (v, digits = 3) => (Number.isFinite(v) ? Number(v.toPrecision(digits)).toString() : '–');
+
+export const panel = {
+  id: 'transfer',
+  title: 'Transfer',
+  create(app) {
+    const { state, viewer, client } = app;
+    const root = fromHtml(markup);
+    const $ = finder(root);
+    const transfer = {
+      step: 0, reference: null, source: null, sameConnectivity: false, pairs: [], pending: null, selected: -1,
+      method: 'yin', result: null, showing: 'result', runs: 0, saved: null, exports: 0,
+    };
+    state.transfer = transfer;
+
+    const steps = new StepList([
+      { title: 'Load the reference (pose) mesh' },
+      { title: 'Load the source (shape) mesh' },
+      { title: 'Landmark pairs' },
+      { title: 'Run the transfer' },
+      { title: 'Compare / export' },
+    ]);
+    $('tr-steps').append(steps.element);
+
+    const pair = new PairView(viewer);
+    const landmarks = new LandmarkPairs();
+    const markers = new LandmarkMarkers(pair, () => viewer.requestRender());
+    const hoverMarker = new VertexMarker({ color: 0xffd23f, onChange: () => viewer.requestRender() });
+    const table = new LandmarkTable({
+      onSelect(i) { transfer.selected = i; refresh(); },
+      onDelete(i) {
+        landmarks.remove(i);
+        transfer.selected = -1;
+        refresh();
+      },
+    });
+    $('tr-table').append(table.element);
+    const gammaMap = new GammaMap();
+    $('tr-gamma').append(gammaMap.element);
+
+    // Per side: {info (load result info), toWelded, weldedToRaw, restRaw (displayed positions),
+    // triangles (welded)}.
+    const meshes = { reference: null, source: null };
+    let result = null;       // welded result positions (Float32Array #W·3) of the last run
+    let resultRaw = null;    // the same in the source's raw layout
+    let form = null;
+    let visible = false;
+
+    // ---- showing the state
+
+    const landmarksReady = () => (transfer.sameConnectivity && landmarks.pairs.length === 0) || landmarks.pairs.length >= minLandmarks;
+
+    function refresh() {
+      transfer.pairs = landmarks.pairs.map((p) => [...p]);
+      transfer.pending = landmarks.pending ? { ...landmarks.pending } : null;
+      if (transfer.selected >= landmarks.pairs.length) transfer.selected = -1;
+      const both = Boolean(meshes.reference && meshes.source);
+      const n = landmarks.pairs.length;
+      let hint;
+      if (!both) hint = 'Load both meshes first.';
+      else if (transfer.sameConnectivity && n === 0) hint = 'Same vertex count and faces: 30 landmark pairs are generated automatically. You may still click your own (at least 6).';
+      else hint = `${n} pair${n === 1 ? '' : 's'}${n < minLandmarks ? ` — at least ${minLandmarks} needed${transfer.sameConnectivity ? ' (or none: then they are generated)' : ''}` : ''}. Click a vertex on the reference (left), then its match on the source (right).`;
+      $('tr-landmark-hint').textContent = hint;
+
+      if (!meshes.reference) {
+        transfer.step = 0;
+        steps.set(0, 'Pick a reference under Reference (or Load the cat example): the mesh whose pose is copied.');
+      } else if (!meshes.source) {
+        transfer.step = 1;
+        steps.set(1, 'Pick a source under Source: the mesh that takes the pose and keeps its details.');
+      } else if (!landmarksReady()) {
+        transfer.step = 2;
+        steps.set(2, transfer.sameConnectivity
+          ? `Click ${minLandmarks - n} more pair(s), or Clear to use generated landmarks.`
+          : `Different connectivity: click a vertex on the reference, then the matching one on the source (${n} of at least ${minLandmarks}); or Load JSON.`);
+      } else if (!transfer.result) {
+        transfer.step = 3;
+        steps.set(3, `${transfer.sameConnectivity && n === 0 ? 'Landmarks are generated automatically (same connectivity). ' : `${n} landmark pairs. `}Choose the method and press Run transfer.`);
+      } else {
+        transfer.step = 4;
+        steps.set(4, 'Toggle Source / Result, read Γ and the metrics, Export GLB.');
+      }
+
+      $('tr-meshes').textContent = both
+        ? `${meshes.reference.info.name} (${meshes.reference.info.weldedVertices} v) → ${meshes.source.info.name} (${meshes.source.info.weldedVertices} v)${transfer.sameConnectivity ? ' · same connectivity' : ' · different connectivity'}`
+        : '';
+      $('tr-result').hidden = !transfer.result;
+      showMarkers();
+      table.show(landmarks.pairs, landmarks.pending, transfer.selected);
+      $('tr-landmarks-save').disabled = n === 0;
+      $('tr-landmarks-clear').disabled = n === 0 && !landmarks.pending;
+    }
+
+    // Landmarks are welded indices; markers go on the first displayed vertex of each.
+    function showMarkers() {
+      if (!meshes.reference || !meshes.source) {
+        markers.clear();
+        viewer.requestRender();
+        return;
+      }
+      const raw = (side, w) => meshes[side].weldedToRaw[w];
+      const pending = landmarks.pending ? { side: landmarks.pending.side, vertex: raw(landmarks.pending.side, landmarks.pending.vertex) } : null;
+      markers.show(landmarks.pairs.map(([r, s]) => [raw('reference', r), raw('source', s)]), pending, transfer.selected);
+    }
+
+    function showSource() {
+      if (!meshes.source) return;
+      const showResult = transfer.showing === 'result' && resultRaw;
+      pair.setPositions('source', (showResult ? resultRaw : meshes.source.restRaw).slice());
+      showMarkers();
+    }
+
+    // ---- loading
+
+    // files: [{name, bytes}] with the mesh file first (ui/files.js).
+    async function loadSide(side, files) {
+      const [main] = files;
+      const buffers = {};
+      for (const f of files) buffers[f.name] = f.bytes;
+      const loaded = await app.runOp(`Loading ${main.name} (${side})`, 'load', { name: main.name, slot: slots[side] }, buffers, { restoreKey: `mesh:${slots[side]}` });
+      if (!loaded) return false;
+      const { buffers: b, info } = loaded;
+      meshes[side] = {
+        info, toWelded: b.toWelded, weldedToRaw: weldedToRaw(b.toWelded, info.weldedVertices),
+        restRaw: b.positions.slice(), triangles: weldedTriangles(b.indices, b.toWelded),
+      };
+      transfer[side] = { name: info.name, rawVertices: info.rawVertices, weldedVertices: info.weldedVertices };
+      app.setStatus(`${side}: ${info.name}, ${info.weldedVertices} vertices, ${info.report.faces} faces · cancel: ${client.cancelMode}`);
+      pair.setMesh(side, b, { open: info.report.boundaryLoopLengths.length > 0 || info.report.components === 0 });
+      // A new mesh: pairs and results of the old one mean nothing on it.
+      landmarks.clear();
+      transfer.selected = -1;
+      clearResult();
+      const { reference, source } = meshes;
+      transfer.sameConnectivity = Boolean(reference && source && reference.info.weldedVertices === source.info.weldedVertices
+        && sameArrays(reference.triangles, source.triangles));
+      refresh();
+      return true;
+    }
+
+    async function loadSample(side, id) {
+      const sample = samples.find((s) => s.id === id);
+      if (!sample) return false;
+      $(`tr-${side}-sample`).value = id;
+      try {
+        return await loadSide(side, await sampleFiles(sample));
+      } catch (e) {
+        app.showError(e);
+        return false;
+      }
+    }
+
+    for (const side of ['reference', 'source']) {
+      const select = $(`tr-${side}-sample`);
+      select.add(new Option('— choose —', ''));
+      for (const s of samples) select.add(new Option(s.label, s.id));
+      select.add(new Option('(your file)', 'file'));
+      select.addEventListener('change', () => {
+        if (select.value && select.value !== 'file') loadSample(side, select.value);
+      });
+      const input = $(`tr-${side}-file`);
+      input.addEventListener('change', async () => {
+        const list = input.files;
+        input.value = '';
+        if (!list.length) return;
+        try {
+          if (await loadSide(side, await userFiles(list))) select.value = 'file';
+        } catch (e) {
+          app.showError(e);
+        }
+      });
+    }
+    $('tr-example').addEventListener('click', async () => {
+      if (await loadSample('reference', example.reference)) await loadSample('source', example.source);
+    });
+
+    // ---- landmark picking (both sides of the pair view)
+
+    attachPointerPicking({ renderer: viewer.renderer, pickAt: (x, y) => (visible ? pair.pickAt(x, y) : null) }, {
+      onHover(pick) {
+        if (!visible) return;
+        if (!pick) {
+          hoverMarker.hide();
+          $('tr-hover').textContent = '';
+          return;
+        }
+        pair.sides[pick.side].mesh.add(hoverMarker.object);
+        hoverMarker.setSize(pair.localRadius(pick.side) * 0.011);
+        hoverMarker.show(pair.localPoint(pick.side, pick.vertex));
+        $('tr-hover').textContent = `${pick.side} vertex #${pick.welded ?? pick.vertex}`;
+      },
+      onClick(pick) {
+        if (!visible || !pick || !meshes.reference || !meshes.source) return;
+        landmarks.click(pick.side, pick.welded ?? pick.vertex);
+        transfer.selected = -1;
+        refresh();
+      },
+    });
+
+    $('tr-landmarks-clear').addEventListener('click', () => {
+      landmarks.clear();
+      transfer.selected = -1;
+      refresh();
+    });
+
+    const stem = (name) => name.replace(/^.*[\\/]/, '').replace(/\.[^.]*$/, '');
+    $('tr-landmarks-save').addEventListener('click', () => {
+      if (!meshes.reference || !meshes.source || !landmarks.pairs.length) return;
+      const file = landmarkFile(landmarks.pairs, { reference: meshes.reference.info.name, source: meshes.source.info.name });
+      transfer.saved = file;
+      download(new TextEncoder().encode(`${JSON.stringify(file, null, 1)}\n`),
+        `${stem(meshes.reference.info.name)}-${stem(meshes.source.info.name)}.json`, 'application/json');
+    });
+
+    $('tr-landmarks-load').addEventListener('change', async () => {
+      const file = $('tr-landmarks-load').files[0];
+      $('tr-landmarks-load').value = '';
+      if (!file) return;
+      if (!meshes.reference || !meshes.source) {
+        app.showError({ code: 'InvalidArgument', message: 'load both meshes before their landmarks' });
+        return;
+      }
+      try {
+        const pairs = readLandmarkFile(JSON.parse(await file.text()), {
+          referenceVertices: meshes.reference.info.weldedVertices, sourceVertices: meshes.source.info.weldedVertices,
+        });
+        landmarks.clear();
+        landmarks.pairs.push(...pairs);
+      } catch (e) {
+        app.showError(e instanceof SyntaxError ? { code: 'ParseError', message: `${file.name}: ${e.message}` } : e);
+        return;
+      }
+      transfer.selected = -1;
+      refresh();
+    });
+
+    // ---- run, compare, show
+
+    function clearResult() {
+      result = null;
+      resultRaw = null;
+      transfer.result = null;
+      gammaMap.hide();
+      if (meshes.source) showSource();
+    }
+
+    $('tr-run').addEventListener('click', async () => {
+      if (!meshes.reference || !meshes.source) {
+        app.showError({ code: 'InvalidArgument', message: 'load the reference and the source first (steps 1 and 2)' });
+        return;
+      }
+      if (!landmarksReady()) {
+        app.showError({ code: 'InvalidArgument', message: `the transfer needs at least ${minLandmarks} landmark pairs (${landmarks.pairs.length} given)${transfer.sameConnectivity ? '; with none, same-connectivity pairs get generated ones' : ''}` });
+        return;
+      }
+      const method = $('tr-method').value;
+      const options = { referenceSlot: slots.reference, sourceSlot: slots.source, method, ...(form ? form.values() : {}) };
+      if (landmarks.pairs.length) options.landmarks = landmarks.pairs.map((p) => [...p]);
+      const ran = await app.runOp(`Pose transfer (${method})`, 'transfer', options);
+      if (!ran) return;
+      const positions = ran.buffers.positions;
+      // compare: the result against the source (flipped faces, detail change); for
+      // same-connectivity pairs also against the reference (how close the pose came).
+      const metrics = await app.runOp('Comparing with the source', 'compare', { slotB: slots.source }, { positionsA: positions.slice() });
+      if (!metrics) return;
+      const toReference = transfer.sameConnectivity
+        ? await app.runOp('Comparing with the reference', 'compare', { slotB: slots.reference }, { positionsA: positions.slice() })
+        : null;
+      result = positions;
+      resultRaw = unweldValues(positions, meshes.source.toWelded, 3);
+      transfer.runs += 1;
+      transfer.method = method;
+      transfer.result = { info: ran.info, metrics: metrics.info, toReference: toReference?.info ?? null, options: { ...options, landmarks: options.landmarks ? options.landmarks.length : 'generated' } };
+      transfer.showing = 'result';
+      root.querySelector('input[name="tr-show"][value="result"]').checked = true;
+      showSource();
+      pair.frame();
+      showResultInfo();
+      refresh();
+      app.setStatus(`transfer (${method}): ${fixed(ran.info.ms.total / 1000, 3)} s`);
+    });
+
+    function showResultInfo() {
+      const { info, metrics, toReference, options } = transfer.result;
+      const lowFrequencies = options.num_low_frequencies ?? form?.controls.get('num_low_frequencies')?.option.default ?? 5;
+      gammaMap.show(info.gamma, info.k, lowFrequencies + 1);
+      const rows = [
+        ['Γ dominance', `${fixed(info.gammaDominance)} (min |Γᵢᵢ| / Σⱼ≠ᵢ |Γᵢⱼ| over the first K+1 rows)`],
+        ['flipped faces', `${metrics.flippedFaces} (result against the source)`],
+        ['detail change', `${fixed(metrics.laplacianChange)} (mean change of |Laplacian coordinates| against the source)`],
+        ['moved', `mean ${fixed(metrics.vertexErrorMean)}, max ${fixed(metrics.vertexErrorMax)} × bbox diagonal from the source`],
+      ];
+      if (toReference) rows.push(['to reference', `mean ${fixed(toReference.vertexErrorMean)} × diagonal (same connectivity: the reference's pose itself)`]);
+      rows.push(['solve', `${options.method}: ${options.method === 'yin' ? `${info.iterations} cage iterations${info.converged ? '' : ' (cap reached)'}, ` : ''}${info.couplingIterations} coupling steps, ${fixed(info.ms.total / 1000)} s`]);
+      const list = $('tr-metrics');
+      list.replaceChildren();
+      for (const [term, text] of rows) {
+        list.append(Object.assign(document.createElement('dt'), { textContent: term }), Object.assign(document.createElement('dd'), { textContent: text }));
+      }
+    }
+
+    for (const radio of root.querySelectorAll('input[name="tr-show"]')) {
+      radio.addEventListener('change', () => {
+        transfer.showing = radio.value;
+        showSource();
+      });
+    }
+
+    $('tr-export').addEventListener('click', async () => {
+      if (!result) return;
+      const exported = await app.runOp('Exporting GLB', 'export', { slot: slots.source, format: 'glb' }, { positions: result.slice() });
+      if (!exported) return;
+      download(exported.buffers.bytes, exported.info.fileName.replace(/\.glb$/, '-posed.glb'), 'model/gltf-binary');
+      transfer.exports += 1;
+    });
+
+    // ---- wiring
+
+    app.on('ready', async () => {
+      try {
+        const schema = (await client.run('optionSchema', { job: 'transfer' }).promise).info;
+        // The method has its own selector above the form.
+        form = new OptionsForm(schema.options.filter((o) => o.name !== 'method'), { title: 'Options' });
+        $('tr-options').append(form.element);
+      } catch (e) {
+        app.showError(e);
+      }
+      refresh();
+    });
+    app.on('job', (job) => {
+      const was = visible;
+      visible = job === 'transfer';
+      if (visible === was) return;
+      pair.setActive(visible);
+      if (!visible) {
+        hoverMarker.hide();
+        viewer.frame(); // the Mesh / Edit jobs' mesh, framed as they left it
+      }
+    });
+    // A mesh loaded in the Mesh job frames the camera on it; while the pair is shown, frame it.
+    app.on('mesh', () => { if (visible) pair.frame(); });
+
+    app.hooks.transferVertexOnScreen = (side, vertex) => vertexOnScreen(viewer, vertex, pair.sides[side]);
+    app.hooks.transferResult = () => (result ? Array.from(result) : null);
+    app.hooks.transferShown = (side = 'source') => Array.from(pair.sides[side].mesh.geometry.getAttribute('position').array);
+    refresh();
+    return root;
+  },
+};

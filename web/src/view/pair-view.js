@@ -1,0 +1,133 @@
+// Two meshes side by side in the viewer's scene (the Transfer job: the reference on the left,
+// the source — or the transfer result — on the right). Each side is a THREE.Mesh with its own
+// VertexPicker (view/picking.js); both are scaled to the same display size (their bounding
+// radius → 1) and placed next to each other, so meshes in different units are comparable.
+// One camera and the viewer's orbit controls look at both; a pick tries both sides and keeps
+// the nearer hit. Points given to and returned by this module are world space unless named
+// `local` (a side's own coordinates, where its markers live as children of its mesh).
+import * as THREE from 'three';
+import { applyArrays } from '../lib/arrays.js';
+import { VertexPicker, ndcFromClient } from './picking.js';
+
+export const sides = ['reference', 'source'];
+const sideColors = { reference: 0xb9c7e0, source: 0xd8cdbf };
+const gap = 0.2; // between the two meshes' bounding spheres, in display radii
+
+function createSide(name) {
+  const material = new THREE.MeshStandardMaterial({
+    color: sideColors[name], roughness: 0.62, metalness: 0.0, side: THREE.DoubleSide,
+    polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1,
+  });
+  const mesh = new THREE.Mesh(new THREE.BufferGeometry(), material);
+  mesh.name = `pair-${name}`;
+  mesh.visible = false;
+  return { name, mesh, picker: new VertexPicker(), toWelded: null, loaded: false };
+}
+
+export class PairView {
+  constructor(viewer) {
+    this.viewer = viewer;
+    this.group = new THREE.Group();
+    this.group.visible = false;
+    viewer.scene.add(this.group);
+    this.sides = Object.fromEntries(sides.map((name) => [name, createSide(name)]));
+    for (const side of Object.values(this.sides)) this.group.add(side.mesh);
+    this.raycaster = new THREE.Raycaster();
+  }
+
+  get active() { return this.group.visible; }
+
+  // Shows the pair instead of the viewer's own mesh (or gives the view back).
+  setActive(on) {
+    if (this.group.visible === on) return;
+    this.group.visible = on;
+    this.viewer.setMainVisible(!on);
+    if (on) this.frame();
+    this.viewer.requestRender();
+  }
+
+  // A mesh for one side: positions/normals/indices (+ toWelded) from a load result; `open` as
+  // in Viewer.setMesh (draw back faces of surfaces with boundaries).
+  setMesh(name, { positions, normals, indices, toWelded = null }, { open = true } = {}) {
+    const side = this.sides[name];
+    const geometry = new THREE.BufferGeometry();
+    applyArrays(geometry, { positions: positions.slice(), normals, indices });
+    if (!normals) geometry.computeVertexNormals();
+    side.mesh.geometry.dispose();
+    side.mesh.geometry = geometry;
+    side.mesh.material.side = open ? THREE.DoubleSide : THREE.FrontSide;
+    side.mesh.material.needsUpdate = true;
+    side.mesh.visible = true;
+    side.toWelded = toWelded;
+    side.loaded = true;
+    side.picker.setTarget(side.mesh, { toWelded });
+    this.layout();
+    this.frame();
+    const schedule = window.requestIdleCallback || ((fn) => setTimeout(fn, 0));
+    schedule(() => {
+      if (side.mesh.geometry === geometry) side.picker.ensureBvh();
+    });
+  }
+
+  // New positions for a side (raw layout, same triangles): the transfer result over the source
+  // or the source back. The side is placed again (the result sits elsewhere than the source),
+  // the camera stays.
+  setPositions(name, positions) {
+    const side = this.sides[name];
+    applyArrays(side.mesh.geometry, { positions });
+    side.mesh.geometry.computeVertexNormals();
+    side.picker.refitLater();
+    this.layout();
+    this.viewer.requestRender();
+  }
+
+  // Display size: both sides scaled to bounding radius 1 and centred on their bounding boxes,
+  // the reference at x = -(1 + gap / 2), the source at x = +(1 + gap / 2): fixed places, so
+  // switching the source for the result (another extent) does not move the other side.
+  layout() {
+    for (const side of Object.values(this.sides)) {
+      const geometry = side.mesh.geometry;
+      if (!side.loaded || !geometry.boundingBox) continue;
+      const scale = 1 / (geometry.boundingSphere.radius || 1);
+      const center = geometry.boundingBox.getCenter(new THREE.Vector3());
+      side.mesh.scale.setScalar(scale);
+      side.mesh.position.copy(center).multiplyScalar(-scale);
+      side.mesh.position.x += (side.name === 'reference' ? -1 : 1) * (1 + gap / 2);
+    }
+    this.group.updateMatrixWorld(true);
+  }
+
+  frame() {
+    const meshes = Object.values(this.sides).filter((s) => s.loaded).map((s) => s.mesh);
+    // Straight from the front (slightly above): both sides at the same distance, the same size.
+    if (meshes.length && this.active) this.viewer.frameMeshes(meshes, { direction: [0, 0.3, 1] });
+  }
+
+  // The vertex under a pointer position on either side: the picking.js result plus `side`, or
+  // null. Both sides are ray cast; the nearer hit wins.
+  pickAt(clientX, clientY) {
+    if (!this.active) return null;
+    const { camera, renderer } = this.viewer;
+    const [x, y] = ndcFromClient(clientX, clientY, renderer.domElement.getBoundingClientRect());
+    camera.updateMatrixWorld();
+    this.raycaster.setFromCamera(new THREE.Vector2(x, y), camera);
+    let best = null;
+    for (const side of Object.values(this.sides)) {
+      if (!side.loaded) continue;
+      const pick = side.picker.pickRay(this.raycaster.ray);
+      if (pick && (!best || pick.distance < best.distance)) best = { ...pick, side: side.name };
+    }
+    return best;
+  }
+
+  // A displayed (raw) vertex of a side: its local position ([x, y, z]).
+  localPoint(name, vertex) {
+    const p = this.sides[name].mesh.geometry.getAttribute('position');
+    return [p.getX(vertex), p.getY(vertex), p.getZ(vertex)];
+  }
+
+  // The display radius of a side's mesh in its local units (markers are sized from it).
+  localRadius(name) {
+    return this.sides[name].mesh.geometry.boundingSphere?.radius || 1;
+  }
+}
