@@ -21,8 +21,16 @@ const char* kEditUsage =
 int run_edit(const std::vector<std::string>& argv) {
   const auto& schema = app::edit_options();
   Args args;
-  Status s = args.parse(argv, {"help", "preview-only", "quiet"});
+  // The last three were switches before the options schema; they are parsed only to say what
+  // replaced them.
+  Status s = args.parse(argv, {"help", "preview-only", "quiet", "naive", "keep-size", "scale-features"});
   if (!s.ok()) return report("edit", s);
+  const std::pair<const char*, const char*> replaced[] = {
+      {"naive", "--method naive"}, {"keep-size", "--features keep"}, {"scale-features", "--features scale"}};
+  for (const auto& [old_flag, now] : replaced)
+    if (args.has(old_flag))
+      return report("edit", Status::error(StatusCode::InvalidArgument,
+                                          std::string("--") + old_flag + " is now " + now + " (see meshmorph edit --help)"));
   if (args.has("help") || args.positional().size() != 1 || !args.has("spec") || !args.has("out")) {
     std::cout << kEditUsage << schema.help();
     return args.has("help") ? 0 : 2;
