@@ -80,16 +80,28 @@ export const panel = {
       }
     }
 
+    // Picking belongs to the Mesh job: other jobs (edit brush, transfer landmarks) use the same
+    // canvas for their own clicks, so hover and pins are hidden while they are shown.
+    let shown = true;
+    app.on('job', (job) => {
+      shown = job === 'mesh';
+      state.pick = null;
+      hoverMarker.hide();
+      if (shown && state.pinned) pinnedMarker.show(state.pinned.point);
+      else pinnedMarker.hide();
+      showPicks();
+    });
+
     attachPointerPicking(viewer, {
       onHover(pick) {
-        if (!state.mesh) return;
+        if (!state.mesh || !shown) return;
         state.pick = pick;
         if (pick) hoverMarker.show(pick.point);
         else hoverMarker.hide();
         showPicks();
       },
       onClick(pick) {
-        if (!state.mesh || !pick) return;
+        if (!state.mesh || !pick || !shown) return;
         state.pinned = pick;
         pinnedMarker.show(pick.point);
         showPicks();
