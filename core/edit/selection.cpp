@@ -19,28 +19,13 @@ std::string edit_sel_vertex_error(const char* what, int index, int n) {
          std::to_string(n) + " vertices)";
 }
 
-// Dijkstra over edge lengths from one seed, stopping at `radius`. Ties are broken by vertex
-// index through the (distance, index) ordering of the queue, so the result is deterministic.
+// The vertices within geodesic (edge-path) distance `radius` of `seed` (mesh/topology.h).
 void edit_sel_geodesic_disk(const Eigen::MatrixXd& V, const std::vector<std::vector<int>>& adjacency,
                             int seed, double radius, std::vector<char>* mark) {
   std::vector<double> dist(adjacency.size(), std::numeric_limits<double>::infinity());
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-  dist[seed] = 0;
-  queue.push({0.0, seed});
-  while (!queue.empty()) {
-    const auto [d, v] = queue.top();
-    queue.pop();
-    if (d > dist[v]) continue;
-    (*mark)[v] = 1;
-    for (int w : adjacency[v]) {
-      const double nd = d + (V.row(v) - V.row(w)).norm();
-      if (nd <= radius && nd < dist[w]) {
-        dist[w] = nd;
-        queue.push({nd, w});
-      }
-    }
-  }
+  relax_edge_distances(V, adjacency, seed, &dist, radius);
+  for (size_t v = 0; v < dist.size(); ++v)
+    if (std::isfinite(dist[v])) (*mark)[v] = 1;
 }
 
 }  // namespace

@@ -1,8 +1,10 @@
 #include "mesh/topology.h"
 
 #include <algorithm>
+#include <functional>
 #include <map>
 #include <numeric>
+#include <queue>
 
 namespace mm {
 
@@ -170,6 +172,27 @@ std::vector<std::vector<int>> boundary_loops(const Eigen::MatrixXi& F, int n) {
     }
   }
   return loops;
+}
+
+void relax_edge_distances(const Eigen::MatrixXd& V, const std::vector<std::vector<int>>& adjacency, int seed,
+                          std::vector<double>* dist, double radius) {
+  std::vector<double>& d = *dist;
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  d[seed] = 0;
+  queue.push({0.0, seed});
+  while (!queue.empty()) {
+    const auto [dv, v] = queue.top();
+    queue.pop();
+    if (dv > d[v]) continue;
+    for (int w : adjacency[v]) {
+      const double nd = dv + (V.row(v) - V.row(w)).norm();
+      if (nd <= radius && nd < d[w]) {
+        d[w] = nd;
+        queue.push({nd, w});
+      }
+    }
+  }
 }
 
 }  // namespace mm

@@ -3,6 +3,7 @@
 // All outputs are sorted / ordered deterministically (by vertex index), never in hash order.
 #pragma once
 
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -15,6 +16,14 @@ std::vector<std::vector<int>> vertex_adjacency(const Eigen::MatrixXi& F, int n);
 
 // Vertices within k edges of `seed` (k = 0 gives {seed}), sorted ascending.
 std::vector<int> k_ring(const std::vector<std::vector<int>>& adjacency, int seed, int k);
+
+// Dijkstra over edge lengths |V_v − V_w| from `seed`, lowering *dist (#V, +inf where unknown) where
+// a shorter path is found and not relaxing past `radius`. Called once per seed with the same
+// *dist it gives the minimum over seeds (farthest-point sampling); with a fresh *dist the vertices
+// within `radius` are those with a finite entry (geodesic disks). Deterministic: ties are broken
+// by vertex index.
+void relax_edge_distances(const Eigen::MatrixXd& V, const std::vector<std::vector<int>>& adjacency, int seed,
+                          std::vector<double>* dist, double radius = std::numeric_limits<double>::infinity());
 
 // Vertices within k edges of any of `seeds`, sorted ascending.
 std::vector<int> k_ring(const std::vector<std::vector<int>>& adjacency,

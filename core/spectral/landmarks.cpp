@@ -89,25 +89,8 @@ std::vector<int> farthest_point_landmarks(const Eigen::MatrixXd& V, const Eigen:
   if (n == 0 || count <= 0) return out;
   const auto adj = vertex_adjacency(F, n);
   std::vector<double> dist(n, std::numeric_limits<double>::infinity());
-  // Dijkstra from the given sources, keeping the minimum over all runs.
-  auto relax_from = [&](int seed, std::vector<double>& d) {
-    using Item = std::pair<double, int>;
-    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> q;
-    d[seed] = 0;
-    q.push({0.0, seed});
-    while (!q.empty()) {
-      const auto [dv, v] = q.top();
-      q.pop();
-      if (dv > d[v]) continue;
-      for (int w : adj[v]) {
-        const double nd = dv + (V.row(v) - V.row(w)).norm();
-        if (nd < d[w]) {
-          d[w] = nd;
-          q.push({nd, w});
-        }
-      }
-    }
-  };
+  // Edge-length Dijkstra from each new sample into the running minimum (mesh/topology.h).
+  auto relax_from = [&](int seed, std::vector<double>& d) { relax_edge_distances(V, adj, seed, &d); };
   auto farthest = [&](const std::vector<double>& d) {
     int best = 0;
     for (int i = 1; i < n; ++i)
