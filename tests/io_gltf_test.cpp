@@ -39,20 +39,6 @@ Eigen::MatrixXd gltf_test_transformed(const Eigen::MatrixXd& V) {
 
 std::vector<uint8_t> gltf_test_bytes(const std::string& s) { return {s.begin(), s.end()}; }
 
-std::string gltf_test_data_uri(const std::vector<uint8_t>& data) {
-  static const char* a = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out = "data:application/octet-stream;base64,";
-  for (size_t i = 0; i < data.size(); i += 3) {
-    const unsigned t = (unsigned(data[i]) << 16) | (i + 1 < data.size() ? unsigned(data[i + 1]) << 8 : 0) |
-                       (i + 2 < data.size() ? unsigned(data[i + 2]) : 0);
-    out += a[(t >> 18) & 63];
-    out += a[(t >> 12) & 63];
-    out += i + 1 < data.size() ? a[(t >> 6) & 63] : '=';
-    out += i + 2 < data.size() ? a[t & 63] : '=';
-  }
-  return out;
-}
-
 template <typename T>
 void gltf_test_append(std::vector<uint8_t>* b, std::initializer_list<T> values) {
   for (T v : values) {
@@ -113,7 +99,7 @@ std::string gltf_test_triangle_gltf(const nlohmann::json& extra) {
       {"scenes", {{{"nodes", {0}}}}},
       {"nodes", {{{"mesh", 0}}}},
       {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}}}}}}},
-      {"buffers", {{{"byteLength", b.size()}, {"uri", gltf_test_data_uri(b)}}}},
+      {"buffers", {{{"byteLength", b.size()}, {"uri", mm::test::data_uri(b)}}}},
       {"bufferViews", {{{"buffer", 0}, {"byteLength", b.size()}}}},
       {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"},
                       {"min", {0, 0, 0}}, {"max", {1, 1, 0}}}}}};
@@ -398,7 +384,7 @@ TEST(IoGltf, ImagesSurviveRoundTrips) {
 
 TEST(IoGltf, DataUriImageStaysADataUri) {
   const std::vector<uint8_t> fake_png = {0x89, 'P', 'N', 'G', 1, 2, 3, 4, 5};
-  std::string uri = gltf_test_data_uri(fake_png);
+  std::string uri = mm::test::data_uri(fake_png);
   uri.replace(0, std::string("data:application/octet-stream").size(), "data:image/png");
   const std::string text = gltf_test_triangle_gltf({{"images", {{{"uri", uri}}}}});
   const auto r = mm::io::load_asset_from_memory(gltf_test_bytes(text), Format::Gltf, "img.gltf");
@@ -466,7 +452,7 @@ TEST(IoGltf, SparseStridedSmallIndicesMatrixNodesAndSceneChoice) {
        {{{"mesh", 0}, {"matrix", {2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 10, 20, 30, 1}}},
         {{"mesh", 0}, {"translation", {100, 0, 0}}}}},
       {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}, {"NORMAL", 1}}}, {"indices", 2}}}}}}},
-      {"buffers", {{{"byteLength", b.size()}, {"uri", gltf_test_data_uri(b)}}}},
+      {"buffers", {{{"byteLength", b.size()}, {"uri", mm::test::data_uri(b)}}}},
       {"bufferViews",
        {{{"buffer", 0}, {"byteLength", 72}, {"byteStride", 24}},
         {{"buffer", 0}, {"byteOffset", 72}, {"byteLength", 3}},

@@ -25,20 +25,6 @@ using io::Format;
 
 std::vector<uint8_t> hostile_bytes(const std::string& s) { return {s.begin(), s.end()}; }
 
-std::string hostile_base64(const std::vector<uint8_t>& data) {
-  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out = "data:application/octet-stream;base64,";
-  for (size_t i = 0; i < data.size(); i += 3) {
-    const uint32_t n = (uint32_t(data[i]) << 16) | (i + 1 < data.size() ? uint32_t(data[i + 1]) << 8 : 0) |
-                       (i + 2 < data.size() ? uint32_t(data[i + 2]) : 0);
-    out += t[(n >> 18) & 63];
-    out += t[(n >> 12) & 63];
-    out += i + 1 < data.size() ? t[(n >> 6) & 63] : '=';
-    out += i + 2 < data.size() ? t[n & 63] : '=';
-  }
-  return out;
-}
-
 // A glTF whose buffer holds `floats` then `indices` (uint16); `patch` is merged into the JSON.
 nlohmann::json hostile_gltf(const std::vector<float>& floats, const std::vector<uint16_t>& indices,
                             const nlohmann::json& patch = nlohmann::json::object()) {
@@ -53,7 +39,7 @@ nlohmann::json hostile_gltf(const std::vector<float>& floats, const std::vector<
       {"scenes", {{{"nodes", {0}}}}},
       {"nodes", {{{"mesh", 0}}}},
       {"meshes", {{{"primitives", {prim}}}}},
-      {"buffers", {{{"byteLength", b.size()}, {"uri", hostile_base64(b)}}}},
+      {"buffers", {{{"byteLength", b.size()}, {"uri", test::data_uri(b)}}}},
       {"bufferViews", {{{"buffer", 0}, {"byteLength", floats.size() * 4}}}},
       {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", floats.size() / 3}, {"type", "VEC3"}}}}};
   if (!indices.empty()) {

@@ -74,4 +74,18 @@ void expect_golden(const std::string& name, const Eigen::MatrixXd& values, doubl
                         << worst_at << " (tolerance " << tol << ")";
 }
 
+std::string data_uri(const std::vector<uint8_t>& data) {
+  static const char* a = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out = "data:application/octet-stream;base64,";
+  for (size_t i = 0; i < data.size(); i += 3) {
+    const unsigned t = (unsigned(data[i]) << 16) | (i + 1 < data.size() ? unsigned(data[i + 1]) << 8 : 0) |
+                       (i + 2 < data.size() ? unsigned(data[i + 2]) : 0);
+    out += a[(t >> 18) & 63];
+    out += a[(t >> 12) & 63];
+    out += i + 1 < data.size() ? a[(t >> 6) & 63] : '=';
+    out += i + 2 < data.size() ? a[t & 63] : '=';
+  }
+  return out;
+}
+
 }  // namespace mm::test

@@ -1,7 +1,9 @@
 // Shared helpers for the GoogleTest suite: data paths, mesh loading, golden files.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -20,6 +22,9 @@ std::string scratch_path(const std::string& name);
 // Loads data/<relative> through mm::io and returns the welded mesh; a load failure is a test
 // failure (EXPECT) and gives an empty mesh.
 Mesh load_mesh(const std::string& relative);
+
+// "data:application/octet-stream;base64,..." of `data` (glTF buffers embedded in test documents).
+std::string data_uri(const std::vector<uint8_t>& data);
 
 // True when the binary was started with --update-golden.
 bool update_golden();

@@ -49,6 +49,15 @@ const char* format_name(Format f) {
   return "unknown";
 }
 
+namespace detail {
+
+static std::string asset_parent_dir(const std::string& path) {
+  const size_t slash = path.find_last_of("/\\");
+  return slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
+}
+
+}  // namespace detail
+
 Status read_file(const std::string& path, std::vector<uint8_t>* bytes) {
   bytes->clear();
   // Only regular files: a directory, FIFO or device would be read forever or fail obscurely.
@@ -93,8 +102,9 @@ Status write_file_atomic(const std::string& path, const std::vector<uint8_t>& by
 
 Status check_output_path(const std::string& path) {
   if (path.empty()) return Status::error(StatusCode::InvalidArgument, "no output path given");
-  const size_t slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  std::string dir = detail::asset_parent_dir(path);  // "" or ending in a separator
+  if (dir.empty()) dir = ".";
+  else if (dir.size() > 1) dir.pop_back();
   struct stat st;
   if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
     return Status::error(StatusCode::IoError, "the output folder '" + quote_input(dir, 200) + "' does not exist");
@@ -111,10 +121,6 @@ static Status asset_write_file(const std::string& path, const std::vector<uint8_
   return write_file_atomic(path, bytes);
 }
 
-static std::string asset_parent_dir(const std::string& path) {
-  const size_t slash = path.find_last_of("/\\");
-  return slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
-}
 
 static std::string asset_stem(const std::string& path) {
   const size_t slash = path.find_last_of("/\\");
