@@ -19,22 +19,7 @@ const OptionSchema<EditJobOptions>& edit_options() {
     s.choice<FeatureSize>("features", [](O& o) -> FeatureSize& { return o.features; },
                           {{"keep", FeatureSize::Keep}, {"scale", FeatureSize::Scale}},
                           "finalize: features keep their size (Eq. 9) or follow handle scaling (Eq. 10)");
-    s.choice<LaplacianWeights>("weights", [](O& o) -> LaplacianWeights& { return o.editor.weights; },
-                               {{"cotangent", LaplacianWeights::Cotangent}, {"uniform", LaplacianWeights::Uniform}},
-                               "Laplacian weights D of Eq. 1");
-    s.integer("coherence_rings", [](O& o) -> int& { return o.editor.coherence_rings; }, 1, 3,
-              "neighbour pairs of the coherence term within this many edges (Eq. 6)");
-    s.number("coherence_weight", [](O& o) -> double& { return o.editor.coherence_weight; }, 1e-12, kUnbounded,
-             "weight of E_R relative to E_L (Eq. 6)");
-    s.number("condition_threshold", [](O& o) -> double& { return o.editor.condition_threshold; }, 1, kUnbounded,
-             "a vertex is degenerate when cond(V_i V_iᵀ) exceeds this (Sec. 3.3)");
-    s.number("displacement_scale", [](O& o) -> double& { return o.editor.displacement_scale; }, 0, kUnbounded,
-             "s_disp of Eq. 8 for degenerate vertices");
-    s.choice<RotatedCoordinates>("rotated_coordinates", [](O& o) -> RotatedCoordinates& { return o.editor.rotated_coordinates; },
-                                 {{"per_edge", RotatedCoordinates::PerEdge}, {"per_vertex", RotatedCoordinates::PerVertex}},
-                                 "finalize: Laplacian coordinates rotated per edge or per vertex (Eq. 9/10)");
-    s.integer("finalize_refinements", [](O& o) -> int& { return o.editor.finalize_refinements; }, 0, 100,
-              "local/global passes after the finalize solve (per_edge only)");
+    add_editor_options<O>(s, [](O& o) -> LaplacianEditOptions& { return o.editor; });
     s.number("gradient_constraint_weight", [](O& o) -> double& { return o.editor.gradient_constraint_weight; }, 0, kUnbounded,
              "pull handle gradients towards the handle's linear part (0 = off)");
     s.number("soft_constraint_weight", [](O& o) -> double& { return o.editor.soft_constraint_weight; }, 0, kUnbounded,

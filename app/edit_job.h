@@ -23,6 +23,29 @@ struct EditJobOptions {
 
 const OptionSchema<EditJobOptions>& edit_options();
 
+// The editing-session options every job built on the editor shares (weights, coherence, degenerate
+// vertices, finalize), added to a job's schema with `editor` reaching its LaplacianEditOptions.
+template <class O>
+void add_editor_options(OptionSchema<O>& s, std::function<LaplacianEditOptions&(O&)> editor) {
+  s.template choice<LaplacianWeights>("weights", [editor](O& o) -> LaplacianWeights& { return editor(o).weights; },
+                                      {{"cotangent", LaplacianWeights::Cotangent}, {"uniform", LaplacianWeights::Uniform}},
+                                      "Laplacian weights D of Eq. 1");
+  s.integer("coherence_rings", [editor](O& o) -> int& { return editor(o).coherence_rings; }, 1, 3,
+            "neighbour pairs of the coherence term within this many edges (Eq. 6)");
+  s.number("coherence_weight", [editor](O& o) -> double& { return editor(o).coherence_weight; }, 1e-12, kUnbounded,
+           "weight of E_R relative to E_L (Eq. 6)");
+  s.number("condition_threshold", [editor](O& o) -> double& { return editor(o).condition_threshold; }, 1, kUnbounded,
+           "a vertex is degenerate when cond(V_i V_iᵀ) exceeds this (Sec. 3.3)");
+  s.number("displacement_scale", [editor](O& o) -> double& { return editor(o).displacement_scale; }, 0, kUnbounded,
+           "s_disp of Eq. 8 for degenerate vertices");
+  s.template choice<RotatedCoordinates>(
+      "rotated_coordinates", [editor](O& o) -> RotatedCoordinates& { return editor(o).rotated_coordinates; },
+      {{"per_edge", RotatedCoordinates::PerEdge}, {"per_vertex", RotatedCoordinates::PerVertex}},
+      "finalize: Laplacian coordinates rotated per edge or per vertex (Eq. 9/10)");
+  s.integer("finalize_refinements", [editor](O& o) -> int& { return editor(o).finalize_refinements; }, 0, 100,
+            "local/global passes after the finalize solve (per_edge only)");
+}
+
 struct EditJobFiles {
   std::string in;    // mesh to edit
   std::string spec;  // JSON edit spec

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/edit_job.h"
+#include "app/json_options.h"
 #include "edit/selection.h"
 #include "io/json_text.h"
 #include "mesh/mesh.h"
@@ -305,27 +306,10 @@ EditSpecResult parse_edit_spec(const std::string& json_text, const Eigen::Matrix
     }
     if (j.contains("options")) {
       // Every key is an edit option of the job's schema (app/edit_job.h), as in the CLI and the page.
-      const EditSpecJson& o = j["options"];
-      if (!o.is_object()) {
-        out.status = Status::error(StatusCode::ParseError, "options must be an object");
-        return out;
-      }
       app::EditJobOptions jo{spec.options, spec.features};
-      for (auto it = o.begin(); it != o.end(); ++it) {
-        const EditSpecJson& v = it.value();
-        app::OptionValue value;
-        if (v.is_boolean()) value = app::OptionValue::of_boolean(v.get<bool>());
-        else if (v.is_number()) value = app::OptionValue::of_number(v.get<double>());
-        else if (v.is_string()) value = app::OptionValue::of_text(v.get<std::string>());
-        else {
-          out.status = Status::error(StatusCode::ParseError, "options." + it.key() + " must be a number, a string or true/false");
-          return out;
-        }
-        const Status s = app::edit_options().set(jo, it.key(), value);
-        if (!s.ok()) {
-          out.status = Status::error(StatusCode::ParseError, "edit spec: " + s.message);
-          return out;
-        }
+      if (const Status s = app::set_options_from_json(j["options"], app::edit_options(), &jo, "edit spec"); !s.ok()) {
+        out.status = s;
+        return out;
       }
       spec.options = jo.editor;
       spec.features = jo.features;

@@ -5,5 +5,6 @@ list(APPEND MM_CORE_SOURCES
   app/transfer_job.cpp
   app/edit_spec.cpp
   app/edit_job.cpp
-  app/retarget_job.cpp)
+  app/retarget_job.cpp
+  app/merge_job.cpp)
 list(APPEND MM_TEST_SOURCES tests/app_test.cpp)

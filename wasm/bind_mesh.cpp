@@ -21,6 +21,9 @@
 //   exportAsset(asset, positions?: Float64Array|Float32Array (#W·3 welded, world space;
 //               undefined keeps the loaded geometry), format = "glb", options? {recompute_normals})
 //     → {ok, bytes: Uint8Array}
+//   exportAssetWithMesh(asset, positions (#V·3), indices (#F·3), format = "glb") → {ok, bytes}: a
+//     mesh of another topology (merge, cut) in place of the asset's geometry, document kept
+//     (io::save_asset_with_mesh_to_memory).
 //   saveMesh(format, positions (#V·3), indices (#F·3), colors? (#V·3 in 0..1)) → {ok, bytes}
 //   validateMesh(positions (#V·3), indices (#F·3), options? {degenerate_area_tolerance})
 //     → {ok: true, report, text}
@@ -252,6 +255,21 @@ val export_asset_js(int id, const val& positions, const std::string& format_name
   return o;
 }
 
+// A new mesh in place of the asset's geometry (merge and cut results), keeping its document.
+val export_asset_with_mesh_js(int id, const val& positions, const val& indices, const std::string& format_name) {
+  const auto it = asset_registry().find(id);
+  if (it == asset_registry().end())
+    return error_object(StatusCode::InvalidArgument, "no loaded asset with id " + std::to_string(id));
+  const std::optional<io::Format> format = parse_format(format_name.empty() ? "glb" : format_name);
+  if (!format) return error_object(StatusCode::InvalidArgument, "unknown export format '" + format_name + "'");
+  std::vector<uint8_t> bytes;
+  const Status s =
+      io::save_asset_with_mesh_to_memory(*it->second, to_matrix(positions), to_index_matrix(indices), *format, &bytes);
+  val o = status_object(s);
+  if (s.ok()) o.set("bytes", to_uint8_array(bytes));
+  return o;
+}
+
 val save_mesh_js(const std::string& format_name, const val& positions, const val& indices,
                  const val& colors) {
   const std::optional<io::Format> format = parse_format(format_name);
@@ -311,6 +329,7 @@ EMSCRIPTEN_BINDINGS(meshmorph_mesh) {
   bind<&load_asset_js>("loadAsset");
   bind<&dispose_asset_js>("disposeAsset");
   bind<&export_asset_js>("exportAsset");
+  bind<&export_asset_with_mesh_js>("exportAssetWithMesh");
   bind<&save_mesh_js>("saveMesh");
   bind<&validate_mesh_js>("validateMesh");
   bind<&spectral_basis_js>("spectralBasis");

@@ -214,6 +214,20 @@ static Status asset_save_impl(const Asset& asset, const Eigen::MatrixXd& V, Form
   return asset_write_export(m, format, &files->main);
 }
 
+// Writes a saved glTF's sidecars (buffers, copied images) next to `path`, then the main file.
+static Status asset_write_files(const std::string& path, const GltfFiles& files) {
+  const std::string dir = asset_parent_dir(path);
+  for (const auto& [name, data] : files.sidecars) {
+    // Image URIs may name a subfolder ("textures/a.png"); they passed the URI check at load.
+    const std::filesystem::path sidecar = std::filesystem::path(dir + name);
+    std::error_code ec;
+    if (sidecar.has_parent_path()) std::filesystem::create_directories(sidecar.parent_path(), ec);
+    Status s = asset_write_file(sidecar.string(), data);
+    if (!s.ok()) return s;
+  }
+  return asset_write_file(path, files.main);
+}
+
 static Status asset_save(const Asset& asset, const Eigen::MatrixXd& V, Format format, const SaveOptions& opt,
                          const std::string& stem, GltfFiles* files) {
   try {
@@ -336,16 +350,47 @@ Status save_asset(const Asset& asset, const Eigen::MatrixXd& V, const std::strin
   GltfFiles files;
   Status s = detail::asset_save(asset, V, *format, opt, *format == Format::Gltf ? detail::asset_stem(path) : "", &files);
   if (!s.ok()) return s;
-  const std::string dir = detail::asset_parent_dir(path);
-  for (const auto& [name, data] : files.sidecars) {
-    // Image URIs may name a subfolder ("textures/a.png"); they passed the URI check at load.
-    const std::filesystem::path sidecar = std::filesystem::path(dir + name);
-    std::error_code ec;
-    if (sidecar.has_parent_path()) std::filesystem::create_directories(sidecar.parent_path(), ec);
-    s = detail::asset_write_file(sidecar.string(), data);
-    if (!s.ok()) return s;
+  return detail::asset_write_files(path, files);
+}
+
+static Status asset_save_with_mesh(const Asset& asset, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                   Format format, const std::string& stem, GltfFiles* files) {
+  Status s = detail::asset_check_mesh(V, F, {});
+  if (!s.ok()) return s;
+  const Document* doc = asset.document.get();
+  try {
+    if (doc && (doc->source_format == Format::Gltf || doc->source_format == Format::Glb) &&
+        (format == Format::Gltf || format == Format::Glb))
+      return save_gltf_with_mesh(asset, V, F, format, stem, files);
+    ExportMesh m;
+    m.V = V;
+    m.F = F;
+    return detail::asset_write_export(m, format, &files->main);
+  } catch (const std::bad_alloc&) {
+    return Status::error(StatusCode::IoError, "out of memory while saving");
+  } catch (const std::exception& e) {
+    return Status::error(StatusCode::IoError, std::string("saving failed: ") + e.what());
   }
-  return detail::asset_write_file(path, files.main);
+}
+
+Status save_asset_with_mesh_to_memory(const Asset& asset, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                      Format format, std::vector<uint8_t>* bytes) {
+  GltfFiles files;
+  Status s = asset_save_with_mesh(asset, V, F, format, "", &files);
+  if (s.ok()) *bytes = std::move(files.main);
+  return s;
+}
+
+Status save_asset_with_mesh(const Asset& asset, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                            const std::string& path) {
+  const std::optional<Format> format = format_from_path(path);
+  if (!format)
+    return Status::error(StatusCode::Unsupported,
+                         "'" + path + "': unknown file extension (expected .gltf, .glb, .obj, .off or .ply)");
+  GltfFiles files;
+  Status s = asset_save_with_mesh(asset, V, F, *format, *format == Format::Gltf ? detail::asset_stem(path) : "", &files);
+  if (!s.ok()) return s;
+  return detail::asset_write_files(path, files);
 }
 
 Status save_mesh_to_memory(Format format, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,

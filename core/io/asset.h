@@ -126,6 +126,17 @@ Status save_asset(const Asset& asset, const Eigen::MatrixXd& V, const std::strin
 Status save_asset_to_memory(const Asset& asset, const Eigen::MatrixXd& V, Format format,
                             std::vector<uint8_t>* bytes, const SaveOptions& opt = {});
 
+// Writes a mesh whose topology differs from the asset's (a merge result; V, F in world space).
+// glTF/GLB in and out: the document is kept (materials, textures, other nodes, skins,
+// animations); the loaded triangle primitives stop being drawn (removed from their mesh, or the
+// mesh detached from its nodes with its skin and morph-weight channels) and a new root node
+// "merged" draws the new mesh with the material of the first loaded primitive. Otherwise a plain
+// mesh in the output format.
+Status save_asset_with_mesh(const Asset& asset, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                            const std::string& path);
+Status save_asset_with_mesh_to_memory(const Asset& asset, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                      Format format, std::vector<uint8_t>* bytes);
+
 // Writes a plain mesh (no source document) in the format of `path`'s extension.
 // Optional per-vertex colors (#V by 3 in 0..1) are written as COLOR_0 / PLY red,green,blue.
 Status save_mesh(const std::string& path, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,

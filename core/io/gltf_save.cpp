@@ -1,7 +1,9 @@
 #include "io/gltf_save.h"
 
 #include <cmath>
+#include <algorithm>
 #include <map>
+#include <set>
 
 #include <Eigen/LU>
 
@@ -178,6 +180,71 @@ Status save_gltf_document(const Asset& asset, const Eigen::MatrixXd& V_raw_out, 
     }
   }
   if (opt.repair_weights) gltf_repair_weights(&m);
+  return serialize_gltf(std::move(m), doc.image_files, target, sidecar_stem, out);
+}
+
+}  // namespace mm::io
+
+namespace mm::io {
+
+Status save_gltf_with_mesh(const Asset& asset, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, Format target,
+                           const std::string& sidecar_stem, GltfFiles* out) {
+  const auto& doc = static_cast<const GltfDocument&>(*asset.document);
+  tinygltf::Model m = doc.model;
+  if (m.buffers.empty()) m.buffers.emplace_back();
+  // The loaded primitives stop being drawn: removed from their mesh, or the mesh (and its skin
+  // and morph-weight animation channels) detached from its nodes when nothing else is left.
+  std::map<int, std::set<int>> loaded;  // mesh → loaded primitive indices
+  for (const PrimitiveRef& ref : asset.primitives) loaded[ref.mesh].insert(ref.primitive);
+  std::set<int> detached_nodes;
+  for (const auto& [mesh, prims] : loaded) {
+    tinygltf::Mesh& mesh_ref = m.meshes[mesh];
+    if (prims.size() < mesh_ref.primitives.size()) {
+      std::vector<tinygltf::Primitive> rest;
+      for (size_t p = 0; p < mesh_ref.primitives.size(); ++p)
+        if (!prims.count(static_cast<int>(p))) rest.push_back(mesh_ref.primitives[p]);
+      mesh_ref.primitives = rest;
+      mesh_ref.weights.clear();
+      continue;
+    }
+    for (size_t n = 0; n < m.nodes.size(); ++n)
+      if (m.nodes[n].mesh == mesh) {
+        m.nodes[n].mesh = -1;
+        m.nodes[n].skin = -1;
+        m.nodes[n].weights.clear();
+        detached_nodes.insert(static_cast<int>(n));
+      }
+  }
+  for (auto& anim : m.animations)
+    anim.channels.erase(std::remove_if(anim.channels.begin(), anim.channels.end(),
+                                       [&](const tinygltf::AnimationChannel& c) {
+                                         return c.target_path == "weights" && detached_nodes.count(c.target_node);
+                                       }),
+                        anim.channels.end());
+  m.animations.erase(std::remove_if(m.animations.begin(), m.animations.end(),
+                                    [](const tinygltf::Animation& a) { return a.channels.empty(); }),
+                     m.animations.end());
+  // The new geometry: one primitive with the first loaded primitive's material, at the root.
+  tinygltf::Primitive prim;
+  prim.mode = TINYGLTF_MODE_TRIANGLES;
+  prim.attributes["POSITION"] = gltf_append_float_accessor(&m, 0, V, true);
+  prim.attributes["NORMAL"] = gltf_append_float_accessor(&m, 0, vertex_normals(V, F), false);
+  prim.indices = gltf_append_index_accessor(&m, 0, F);
+  if (!asset.primitives.empty()) {
+    const PrimitiveRef& first = asset.primitives[0];
+    prim.material = doc.model.meshes[first.mesh].primitives[first.primitive].material;
+  }
+  tinygltf::Mesh mesh;
+  mesh.name = "merged";
+  mesh.primitives.push_back(prim);
+  m.meshes.push_back(mesh);
+  tinygltf::Node node;
+  node.name = "merged";
+  node.mesh = static_cast<int>(m.meshes.size()) - 1;
+  m.nodes.push_back(node);
+  if (m.scenes.empty()) m.scenes.emplace_back();
+  const int scene = m.defaultScene >= 0 && m.defaultScene < static_cast<int>(m.scenes.size()) ? m.defaultScene : 0;
+  m.scenes[scene].nodes.push_back(static_cast<int>(m.nodes.size()) - 1);
   return serialize_gltf(std::move(m), doc.image_files, target, sidecar_stem, out);
 }
 

@@ -29,3 +29,12 @@ Status save_gltf_document(const Asset& asset, const Eigen::MatrixXd& V_raw_out, 
                           Format target, const SaveOptions& opt, const std::string& sidecar_stem, GltfFiles* out);
 
 }  // namespace mm::io
+
+namespace mm::io {
+
+// save_asset_with_mesh for a glTF document (see io/asset.h): the document with the loaded
+// triangle primitives replaced by one new primitive (V, F in world space) under a new root node.
+Status save_gltf_with_mesh(const Asset& asset, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, Format target,
+                           const std::string& sidecar_stem, GltfFiles* out);
+
+}  // namespace mm::io

@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "app/edit_job.h"
+#include "app/merge_job.h"
 #include "app/retarget_job.h"
 #include "app/transfer_job.h"
 #include "cli.h"
@@ -15,7 +16,7 @@ int run_options(const std::vector<std::string>& argv) {
   Status s = args.parse(argv, {"help", "json"});
   if (!s.ok()) return report("options", s);
   if (args.has("help") || args.positional().size() > 1) {
-    std::cout << "usage: meshmorph options [edit|transfer|retarget] [--json]\n"
+    std::cout << "usage: meshmorph options [edit|merge|transfer|retarget] [--json]\n"
                  "  Lists each job's options with defaults, ranges and help; --json prints the schema\n"
                  "  the page builds its options panels from ({\"jobs\": [...]}).\n";
     return args.has("help") ? 0 : 2;
@@ -27,6 +28,7 @@ int run_options(const std::vector<std::string>& argv) {
     std::string name, json, help;
   };
   const Job jobs[] = {{"edit", app::edit_options().json(), app::edit_options().help()},
+                      {"merge", app::merge_options().json(), app::merge_options().help()},
                       {"transfer", app::transfer_options().json(), app::transfer_options().help()},
                       {"retarget", app::retarget_options().json(), app::retarget_options().help()}};
   bool found = only.empty();
@@ -37,7 +39,7 @@ int run_options(const std::vector<std::string>& argv) {
     if (json) out += (out.empty() ? "" : ",\n") + j.json;
     else out += j.name + ":\n" + j.help;
   }
-  if (!found) return report("options", Status::error(StatusCode::InvalidArgument, "no job named '" + only.substr(0, 40) + "' (edit, transfer, retarget)"));
+  if (!found) return report("options", Status::error(StatusCode::InvalidArgument, "no job named '" + only.substr(0, 40) + "' (edit, merge, transfer, retarget)"));
   std::cout << (json ? "{\"jobs\": [" + out + "]}\n" : out);
   return 0;
 }
