@@ -35,6 +35,10 @@ const OptionSchema<MergeOptions>& merge_options() {
               "vertices within this many edges of the seam are smoothed");
     s.number("smoothing_step", [](O& o) -> double& { return o.smoothing_step; }, 0, 1,
              "step of each umbrella iteration");
+    s.number("transition_target_width", [](O& o) -> double& { return o.transition_target_width; }, 0, kUnbounded,
+             "transition region on the target side of the seam (Sec. 5.3), × target diagonal; 0 = off");
+    s.number("transition_source_width", [](O& o) -> double& { return o.transition_source_width; }, 0, kUnbounded,
+             "transition region on the source side of the seam (Sec. 5.3), × target diagonal; 0 = off");
     s.boolean("zip", [](O& o) -> bool& { return o.zip; },
               "join the meshes into one watertight mesh (false: deformed source beside the target)");
     add_editor_options<O>(s, [](O& o) -> LaplacianEditOptions& { return o.editor; });

@@ -264,6 +264,11 @@ MergeResult merge_meshes(const MergeInput& in, const MergeOptions& opt, const Pr
       opt.smoothing_rings > 20 || !(opt.smoothing_step >= 0 && opt.smoothing_step <= 1))
     return merge_error(StatusCode::InvalidArgument,
                        "merge: smoothing_iterations must be 0..1000, smoothing_rings 0..20, smoothing_step in [0, 1]");
+  if (!(opt.transition_target_width >= 0 && opt.transition_source_width >= 0) ||
+      !std::isfinite(opt.transition_target_width + opt.transition_source_width) ||
+      ((opt.transition_target_width > 0) != (opt.transition_source_width > 0)))
+    return merge_error(StatusCode::InvalidArgument,
+                       "merge: transition widths must both be positive (transition regions on) or both 0 (off)");
   if (!(opt.roi_width > 0))
     return merge_error(StatusCode::InvalidArgument, "merge: roi_width must be positive");
   const bool dependent = opt.mode == MergeMode::ConfigurationDependent;
@@ -411,6 +416,9 @@ MergeResult merge_meshes(const MergeInput& in, const MergeOptions& opt, const Pr
   zopt.smoothing_iterations = opt.smoothing_iterations;
   zopt.smoothing_rings = opt.smoothing_rings;
   zopt.smoothing_step = opt.smoothing_step;
+  const double tdiag = bounding_box_diagonal(in.target_V);
+  zopt.transition_target_width = opt.transition_target_width * tdiag;
+  zopt.transition_source_width = opt.transition_source_width * tdiag;
   ZipResult z = zip_meshes(in.target_V, in.target_F, out.source_deformed, Fs, seams, zopt);
   if (!z.status.ok()) return merge_error(z.status.code, "merge: " + z.status.message);
   out.V = std::move(z.V);
@@ -418,6 +426,7 @@ MergeResult merge_meshes(const MergeInput& in, const MergeOptions& opt, const Pr
   out.target_map = std::move(z.target_map);
   out.source_offset = z.source_offset;
   out.stats.seams = std::move(z.seams);
+  out.stats.transition_vertices = z.transition_vertices;
   out.stats.zip_ms = ms_since(&clock);
   if (!out.V.allFinite()) return merge_error(StatusCode::NumericalError, "merge: the result has non-finite positions");
   progress.update("merge: done", 1.0);

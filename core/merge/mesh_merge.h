@@ -82,6 +82,11 @@ struct MergeOptions {
   // Configuration-dependent mode: ROI = source vertices whose geodesic distance to the source
   // boundary is below roi_width × the source's bounding-box diagonal. (0, ∞].
   double roi_width = 0.25;
+  // Transition regions (Sec. 5.3, merge/transition.h): widths of the blended band on each side of
+  // the seam, × the target's bounding-box diagonal. Both > 0 turns them on (the umbrella
+  // smoothing still runs after them); 0 = off.
+  double transition_target_width = 0;
+  double transition_source_width = 0;
   bool zip = true;  // false: return the deformed source and the untouched target side by side
 };
 
@@ -101,6 +106,7 @@ struct MergeStats {
   double precompute_ms = 0, solve_ms = 0, zip_ms = 0;
   EditStats editor;
   std::vector<MergeSeamReport> seams;  // one per pair (empty when zip = false)
+  int transition_vertices = 0;         // vertices rebuilt by the transition regions
 };
 
 struct MergeResult {

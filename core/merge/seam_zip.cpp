@@ -6,6 +6,7 @@
 #include <map>
 #include <string>
 
+#include "merge/transition.h"
 #include "mesh/topology.h"
 #include "operators/operators.h"
 
@@ -168,6 +169,7 @@ ZipResult zip_meshes(const Eigen::MatrixXd& Vt, const Eigen::MatrixXi& Ft, const
   // source loop. Advancing on I adds (I[i+1], I[i], J[j]); on J adds (J[j], J[j+1], I[i]), which
   // keeps the target's orientation (docs/merge.md). Both curves advance in step by normalized arc length.
   std::vector<std::vector<int>> zip_faces(S);
+  std::vector<TransitionSeam> transition(S);
   for (int i = 0; opt.enabled && i < S; ++i) {
     std::vector<int> I(inner[i].size()), J(seams[i].source_loop.size());
     for (size_t k = 0; k < I.size(); ++k) I[k] = r.target_map[inner[i][k]];
@@ -192,6 +194,8 @@ ZipResult zip_meshes(const Eigen::MatrixXd& Vt, const Eigen::MatrixXi& Ft, const
       return u;
     };
     const std::vector<double> ui = arc(I, i0), uj = arc(J, 0);
+    for (int k = 0; k < mi; ++k) transition[i].target_side.push_back(I[(i0 + k) % mi]);
+    transition[i].source_side = J;
     int ci = 0, cj = 0;
     while (ci < mi || cj < mj) {
       const int a = I[(i0 + ci) % mi], a1 = I[(i0 + ci + 1) % mi];
@@ -217,6 +221,38 @@ ZipResult zip_meshes(const Eigen::MatrixXd& Vt, const Eigen::MatrixXi& Ft, const
   r.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
   for (size_t f = 0; f < faces.size(); ++f) r.F.row(static_cast<Eigen::Index>(f)) = faces[f].transpose();
   if (!opt.enabled) return r;
+  // ---- transition regions (Sec. 5.3): details of both sides blended across the seam
+  const bool blend = opt.transition_target_width > 0 && opt.transition_source_width > 0;
+  if (blend) {
+    // Mean-curvature normals of the surfaces the vertices came from (transition.h).
+    Eigen::MatrixXd H(r.V.rows(), 3);
+    const Eigen::MatrixXd Ht = (cotan_stiffness(Vt, Ft) * Vt).array().colwise() / mass_diagonal(Vt, Ft).array().max(1e-300);
+    for (int v = 0; v < nt; ++v)
+      if (r.target_map[v] >= 0) H.row(r.target_map[v]) = Ht.row(v);
+    Eigen::MatrixXd Hs = (cotan_stiffness(Vs, Fs) * Vs).array().colwise() / mass_diagonal(Vs, Fs).array().max(1e-300);
+    // The source's merged loops are boundaries there: take the mean of their interior neighbours.
+    std::vector<char> loop_vertex(ns, 0);
+    for (const SeamCurves& c : seams)
+      for (int v : c.source_loop) loop_vertex[v] = 1;
+    const auto sadj = vertex_adjacency(Fs, ns);
+    for (int v = 0; v < ns; ++v) {
+      if (!loop_vertex[v]) continue;
+      Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+      int count = 0;
+      for (int w : sadj[v])
+        if (!loop_vertex[w]) {
+          sum += Hs.row(w);
+          ++count;
+        }
+      Hs.row(v) = count ? Eigen::RowVector3d(sum / count) : Eigen::RowVector3d::Zero();
+    }
+    H.bottomRows(ns) = Hs;
+    TransitionReport tr;
+    r.status = blend_transition(&r.V, r.F, m, transition, opt.transition_target_width, opt.transition_source_width, H,
+                                &tr);
+    if (!r.status.ok()) return r;
+    r.transition_vertices = tr.region_vertices;
+  }
   // ---- umbrella smoothing [Tau95] of the vertices near the seams
   std::vector<int> seeds;
   for (const auto& zf : zip_faces)

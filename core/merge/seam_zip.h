@@ -26,6 +26,10 @@ struct ZipOptions {
   int smoothing_iterations = 3;
   int smoothing_rings = 2;
   double smoothing_step = 0.5;
+  // Transition regions (merge/transition.h), mesh units; both > 0 turns them on (before the
+  // umbrella smoothing, which then only evens out the zip strip).
+  double transition_target_width = 0;
+  double transition_source_width = 0;
 };
 
 struct ZipResult {
@@ -35,6 +39,7 @@ struct ZipResult {
   std::vector<int> target_map;  // per target vertex: index in V or -1
   int source_offset = 0;
   std::vector<MergeSeamReport> seams;
+  int transition_vertices = 0;  // vertices rebuilt by the transition regions
 };
 
 ZipResult zip_meshes(const Eigen::MatrixXd& Vt, const Eigen::MatrixXi& Ft, const Eigen::MatrixXd& Vs,
