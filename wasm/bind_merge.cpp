@@ -33,7 +33,7 @@ using emscripten::val;
 
 namespace {
 
-val int_array(const std::vector<int>& v) {
+val merge_int_array(const std::vector<int>& v) {
   Eigen::MatrixXi M(static_cast<Eigen::Index>(v.size()), 1);
   for (size_t i = 0; i < v.size(); ++i) M(static_cast<Eigen::Index>(i), 0) = v[i];
   return val::global("Int32Array").new_(to_uint32_array(M)["buffer"]);
@@ -57,7 +57,7 @@ val merge_meshes_js(val target_positions, val target_indices, val source_positio
   out.set("indices", to_uint32_array(r.F));
   out.set("sourcePositions", to_float64_array(r.source_deformed));
   out.set("sourceIndices", to_uint32_array(r.source_F));
-  out.set("targetMap", int_array(r.target_map));
+  out.set("targetMap", merge_int_array(r.target_map));
   out.set("sourceOffset", r.source_offset);
   val stats = val::object();
   stats.set("targetVertices", r.stats.target_vertices);
@@ -114,7 +114,7 @@ val cut_mesh_js(val positions, val indices, val request) {
   if (!c.status.ok()) return out;
   out.set("positions", to_float64_array(c.V));
   out.set("indices", to_uint32_array(c.F));
-  out.set("from", int_array(c.from));
+  out.set("from", merge_int_array(c.from));
   out.set("boundaryLoops", c.boundary_loops);
   return out;
 }
@@ -125,7 +125,7 @@ val boundary_loops_js(val indices, int vertex_count) {
     return status_object(Status::error(StatusCode::InvalidArgument, "indices out of range"));
   val out = status_object(Status::success());
   val loops = val::array();
-  for (const std::vector<int>& l : boundary_loops(F, vertex_count)) loops.call<void>("push", int_array(l));
+  for (const std::vector<int>& l : boundary_loops(F, vertex_count)) loops.call<void>("push", merge_int_array(l));
   out.set("loops", loops);
   return out;
 }
