@@ -378,7 +378,7 @@ TEST(MergeSpec, ParsesAndRefusesUnknownKeys) {
                           "[", "[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[["}) {
     const app::MergeSpecResult b = app::parse_merge_spec(bad);
     EXPECT_FALSE(b.status.ok()) << bad;
-    EXPECT_LT(b.status.message.size(), 300u);
+    EXPECT_LT(b.status.message.size(), 700u);  // an unknown option lists the known ones; input is quoted ≤ 100 bytes
   }
 }
 
