@@ -259,6 +259,69 @@ Eigen::Matrix3d LaplacianEditor::Impl::gradient_local(int l) const {
 // with m_a(y) = Σ_k w_k y_k over the stencil of a (a 3-vector: row r of M_a for coordinate r).
 // Hence Aᵀ(b − A y) = −E1ᵀ E1 y − cw Σ_a K_a Z_a − wg Σ_p K_p (m_p − B_h) + soft (t − y), with
 // Z_a = Σ_{b ~ a} (m_a − m_b) over a's partners (each unordered pair is listed from both ends).
+namespace {
+
+// The E_R and gradient-constraint part of stage1_normal_residual over row-major m-column blocks.
+// M = m at compile time (3: a drag, 4 or 8: the basis of 1 or 2 handles) lets the compiler unroll
+// and vectorise the 3-by-m block loops (they are most of the residual's cost); 0 = any m.
+struct ResidualPairs {
+  int nP, nU, m;
+  const int *pair_center, *offsets, *stencil_local, *partner_ptr, *partners, *pair_handle;
+  const char* pair_active;
+  const double* weights;  // column-major #entries by 3
+  long wstride;
+  double cw, wg;
+  const std::vector<Eigen::MatrixXd>* grad_rhs;
+};
+
+template <int M>
+void residual_pairs(const ResidualPairs& a, const double* Y, double* Mg, double* G) {
+  const int m = M > 0 ? M : a.m;
+  for (int p = 0; p < a.nP; ++p) {
+    const int c = a.pair_center[p];
+    double* M0 = Mg + 3 * static_cast<long>(p) * m;
+    double *M1 = M0 + m, *M2 = M1 + m;
+    for (int e = a.offsets[c]; e < a.offsets[c + 1]; ++e) {
+      const double w0 = a.weights[e], w1 = a.weights[e + a.wstride], w2 = a.weights[e + 2 * a.wstride];
+      const double* y = Y + static_cast<long>(a.stencil_local[e]) * m;
+      for (int k = 0; k < m; ++k) {
+        M0[k] += w0 * y[k];
+        M1[k] += w1 * y[k];
+        M2[k] += w2 * y[k];
+      }
+    }
+  }
+  std::vector<double> Zbuf(3 * static_cast<size_t>(m));
+  double* Z = Zbuf.data();
+  for (int p = 0; p < a.nP; ++p) {
+    if (!a.pair_active[p]) continue;  // its stencil has no unknown: no column of A_U to feed
+    const double* Mp = Mg + 3 * static_cast<long>(p) * m;
+    const int deg = a.partner_ptr[p + 1] - a.partner_ptr[p];
+    // Z = Σ_q (M_p − M_q) = deg·M_p − Σ_q M_q (the sum first: fewer operations per partner).
+    for (int k = 0; k < 3 * m; ++k) Z[k] = 0.0;
+    for (int q = a.partner_ptr[p]; q < a.partner_ptr[p + 1]; ++q) {
+      const double* Mq = Mg + 3 * static_cast<long>(a.partners[q]) * m;
+      for (int k = 0; k < 3 * m; ++k) Z[k] += Mq[k];
+    }
+    for (int k = 0; k < 3 * m; ++k) Z[k] = a.cw * (deg * Mp[k] - Z[k]);
+    if (a.pair_handle[p] >= 0) {
+      const Eigen::MatrixXd& B = (*a.grad_rhs)[a.pair_handle[p]];  // 3 by m
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < m; ++k) Z[r * m + k] += a.wg * (Mp[r * m + k] - B(r, k));
+    }
+    const int c = a.pair_center[p];
+    for (int e = a.offsets[c]; e < a.offsets[c + 1]; ++e) {
+      const int j = a.stencil_local[e];
+      if (j >= a.nU) continue;
+      const double w0 = a.weights[e], w1 = a.weights[e + a.wstride], w2 = a.weights[e + 2 * a.wstride];
+      double* gj = G + static_cast<long>(j) * m;
+      for (int k = 0; k < m; ++k) gj[k] -= w0 * Z[k] + w1 * Z[m + k] + w2 * Z[2 * m + k];
+    }
+  }
+}
+
+}  // namespace
+
 void LaplacianEditor::Impl::stage1_normal_residual(const Eigen::MatrixXd& Y, const std::vector<Eigen::MatrixXd>& grad_rhs,
                                                    const Eigen::MatrixXd& soft_target, Eigen::MatrixXd* g) const {
   using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
@@ -268,27 +331,14 @@ void LaplacianEditor::Impl::stage1_normal_residual(const Eigen::MatrixXd& Y, con
   RowMat G = -(E1.transpose() * EY).topRows(nU);
   const RowMat Yr = Y;
   RowMat Mg = RowMat::Zero(3 * static_cast<Eigen::Index>(nP), m);
-  for (int p = 0; p < nP; ++p) {
-    const int c = pair_center[p];
-    auto Mp = Mg.middleRows(3 * p, 3);
-    for (int e = grads.offsets[c]; e < grads.offsets[c + 1]; ++e)
-      Mp.noalias() += grads.weights.row(e).transpose() * Yr.row(stencil_local[e]);
-  }
-  const double cw = opt.coherence_weight, wg = opt.gradient_constraint_weight;
-  RowMat Z(3, m);
-  for (int p = 0; p < nP; ++p) {
-    if (!pair_active[p]) continue;  // its stencil has no unknown: no column of A_U to feed
-    const auto Mp = Mg.middleRows(3 * p, 3);
-    Z.setZero();
-    for (int k = partner_ptr[p]; k < partner_ptr[p + 1]; ++k) Z += Mp - Mg.middleRows(3 * partners[k], 3);
-    Z *= cw;
-    if (pair_handle[p] >= 0) Z += wg * (Mp - grad_rhs[pair_handle[p]]);
-    const int c = pair_center[p];
-    for (int e = grads.offsets[c]; e < grads.offsets[c + 1]; ++e) {
-      const int j = stencil_local[e];
-      if (j < nU) G.row(j).noalias() -= grads.weights.row(e) * Z;
-    }
-  }
+  const ResidualPairs a{nP, nU, m, pair_center.data(), grads.offsets.data(), stencil_local.data(), partner_ptr.data(),
+                        partners.data(), pair_handle.data(), pair_active.data(), grads.weights.data(),
+                        static_cast<long>(grads.weights.rows()), opt.coherence_weight, opt.gradient_constraint_weight,
+                        &grad_rhs};
+  if (m == 3) residual_pairs<3>(a, Yr.data(), Mg.data(), G.data());
+  else if (m == 4) residual_pairs<4>(a, Yr.data(), Mg.data(), G.data());
+  else if (m == 8) residual_pairs<8>(a, Yr.data(), Mg.data(), G.data());
+  else residual_pairs<0>(a, Yr.data(), Mg.data(), G.data());
   if (soft_target.size())
     for (int l = 0; l < nU; ++l)
       if (soft[l] > 0) G.row(l) += soft[l] * (soft_target.row(l) - Y.row(l));
