@@ -26,6 +26,8 @@ const OptionSchema<EditJobOptions>& edit_options() {
              "0 = hard handle/fixed constraints (paper); > 0 = soft with this weight");
     s.boolean("handle_basis", [](O& o) -> bool& { return o.editor.handle_basis; },
               "precompute a per-handle basis so that drags are a small dense product");
+    s.integer("residual_refinements", [](O& o) -> int& { return o.editor.residual_refinements; }, 0, 10,
+              "iterative-refinement steps of each solve against the unsquared system (0 = off)");
     return s;
   }();
   return schema;

@@ -74,6 +74,8 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
     return Status::error(StatusCode::InvalidArgument, "coherence_rings must be 1, 2 or 3");
   if (!(opt.finalize_refinements >= 0 && opt.finalize_refinements <= 100))
     return Status::error(StatusCode::InvalidArgument, "finalize_refinements must be between 0 and 100");
+  if (!(opt.residual_refinements >= 0 && opt.residual_refinements <= 10))
+    return Status::error(StatusCode::InvalidArgument, "residual_refinements must be between 0 and 10");
   if (!(opt.coherence_weight > 0) || !(opt.condition_threshold > 1) || !(opt.displacement_scale > 0) ||
       !(opt.gradient_constraint_weight >= 0) || !(opt.soft_constraint_weight >= 0) ||
       !std::isfinite(opt.coherence_weight + opt.condition_threshold + opt.displacement_scale +
@@ -128,21 +130,26 @@ EditResult LaplacianEditor::drag(const std::vector<HandleTransform>& transforms)
     if (g < 0) return p;
     return (transforms[g].linear * p.transpose() + transforms[g].translation).transpose();
   };
+  // Displacement of a displaced rest position: (A − I) v' + t, exactly zero for the identity.
+  auto displacement = [&](int g, const Eigen::RowVector3d& p) -> Eigen::RowVector3d {
+    if (g < 0) return Eigen::RowVector3d::Zero();
+    return ((transforms[g].linear - Eigen::Matrix3d::Identity()) * p.transpose() + transforms[g].translation).transpose();
+  };
   m.known.resize(nK, 3);
-  Eigen::MatrixXd known_d(nK, 3);
+  Eigen::MatrixXd known_u(nK, 3);
   for (int k = 0; k < nK; ++k) {
     const int l = m.nU + k, v = m.l2g[l];
     m.known.row(k) = map(m.group[l], m.V.row(v));
-    known_d.row(k) = map(m.group[l], m.Vd.row(v));
+    known_u.row(k) = displacement(m.group[l], m.Vd.row(v));
   }
-  Eigen::MatrixXd soft_d;
+  Eigen::MatrixXd soft_ud;
   if (m.opt.soft_constraint_weight > 0) {
     m.soft_u = Eigen::MatrixXd::Zero(m.nU, 3);
-    soft_d = Eigen::MatrixXd::Zero(m.nU, 3);
+    soft_ud = Eigen::MatrixXd::Zero(m.nU, 3);
     for (int l = 0; l < m.nU; ++l)
       if (m.soft[l] > 0) {
         m.soft_u.row(l) = map(m.group[l], m.V.row(m.l2g[l]));
-        soft_d.row(l) = map(m.group[l], m.Vd.row(m.l2g[l]));
+        soft_ud.row(l) = displacement(m.group[l], m.Vd.row(m.l2g[l]));
       }
   }
   if (m.opt.method == EditMethod::NaiveLaplacian) {
@@ -155,13 +162,14 @@ EditResult LaplacianEditor::drag(const std::vector<HandleTransform>& transforms)
     linear[h] = transforms[h].linear;
     translation[h] = transforms[h].translation;
   }
-  if (Status s = m.solve_stage1(known_d, soft_d, linear, &translation); !s.ok()) {
+  int refinements = 0;
+  if (Status s = m.solve_stage1(known_u, soft_ud, linear, &translation, &refinements); !s.ok()) {
     EditResult r;
     r.status = s;
     return r;
   }
   m.have_drag = true;
-  return m.output_stage1();
+  return m.output_stage1(refinements);
 }
 
 EditResult LaplacianEditor::drag_positions(const Eigen::MatrixXd& targets) {
@@ -186,46 +194,51 @@ EditResult LaplacianEditor::drag_positions(const Eigen::MatrixXd& targets) {
   }
   const int nK = m.nL - m.nU;
   m.known.resize(nK, 3);
-  Eigen::MatrixXd known_d(nK, 3);
+  Eigen::MatrixXd known_u(nK, 3);
+  // Target in the original frame, and the displacement of the displaced rest position v' (whose
+  // target is t + A (v' − v), the handle's linear part carrying the Eq. 8 offset):
+  // (t − v) + (A − I)(v' − v), exactly zero for targets at rest with A = I.
   auto target_of = [&](int l, Eigen::RowVector3d* orig, Eigen::RowVector3d* disp) {
     const int v = m.l2g[l], g = m.group[l];
     if (g < 0) {
       *orig = m.V.row(v);
-      *disp = m.Vd.row(v);
+      disp->setZero();
     } else {
       *orig = targets.row(v);
-      *disp = *orig + (linear[g] * (m.Vd.row(v) - m.V.row(v)).transpose()).transpose();
+      *disp = (targets.row(v) - m.V.row(v)) +
+              ((linear[g] - Eigen::Matrix3d::Identity()) * (m.Vd.row(v) - m.V.row(v)).transpose()).transpose();
     }
   };
   for (int k = 0; k < nK; ++k) {
     Eigen::RowVector3d o, d;
     target_of(m.nU + k, &o, &d);
     m.known.row(k) = o;
-    known_d.row(k) = d;
+    known_u.row(k) = d;
   }
-  Eigen::MatrixXd soft_d;
+  Eigen::MatrixXd soft_ud;
   if (m.opt.soft_constraint_weight > 0) {
     m.soft_u = Eigen::MatrixXd::Zero(m.nU, 3);
-    soft_d = Eigen::MatrixXd::Zero(m.nU, 3);
+    soft_ud = Eigen::MatrixXd::Zero(m.nU, 3);
     for (int l = 0; l < m.nU; ++l)
       if (m.soft[l] > 0) {
         Eigen::RowVector3d o, d;
         target_of(l, &o, &d);
         m.soft_u.row(l) = o;
-        soft_d.row(l) = d;
+        soft_ud.row(l) = d;
       }
   }
   if (m.opt.method == EditMethod::NaiveLaplacian) {
     m.have_drag = true;
     return m.solve_stage2(false, FeatureSize::Keep);
   }
-  if (Status s = m.solve_stage1(known_d, soft_d, linear, nullptr); !s.ok()) {
+  int refinements = 0;
+  if (Status s = m.solve_stage1(known_u, soft_ud, linear, nullptr, &refinements); !s.ok()) {
     EditResult r;
     r.status = s;
     return r;
   }
   m.have_drag = true;
-  return m.output_stage1();
+  return m.output_stage1(refinements);
 }
 
 EditResult LaplacianEditor::finalize(FeatureSize mode) {

@@ -81,10 +81,16 @@ struct LaplacianEditor::Impl {
   // Stage 1 (Eq. 7): AᵀA has a 4-ring pattern; the supernodal factor is 2.5–4× faster there
   // than Eigen::SimplicialLDLT (measured at 14.6k and 52k vertices).
   SupernodalCholesky solver1;
-  edit_detail::EditSparse Q1;        // nU by nK: the block N_UK of AᵀA
-  Eigen::MatrixXd G1;            // nU by 3·H: gradient-constraint right-hand side per handle
-  Eigen::MatrixXd Phi0;          // nU by 3
-  std::vector<Eigen::MatrixXd> Phi;  // per handle nU by 4
+  // The unsquared operator A of Eq. 7, kept for the residuals of iterative refinement: the E_L
+  // rows as a matrix, the E_R and gradient-constraint rows through the stencils (they would be
+  // ~17M entries at 50k vertices) and the pair graph.
+  edit_detail::EditSparse E1;      // nU by nL: E_L rows (Eq. 5), scaled (zero rows without a Laplacian row)
+  std::vector<int> pair_center;    // per E_R center p: index into grads.centers
+  std::vector<char> pair_active;   // per p: its gradient involves an unknown
+  std::vector<int> pair_handle;    // per p: handle of its gradient-constraint rows, -1 none
+  std::vector<int> partner_ptr, partners;  // per p: its E_R partners (indices p), both directions
+  std::vector<Eigen::Vector3d> handle_center;  // per handle: centroid of its displaced rest positions
+  std::vector<Eigen::MatrixXd> Phi;  // per handle nU by 4: response to [(A_h − I) τ_h]ᵀ
   bool have_basis = false;
 
   // Stage 2 (Eq. 9/10) on the undisplaced mesh (1-ring pattern; supernodal solves are faster).
@@ -100,7 +106,7 @@ struct LaplacianEditor::Impl {
 
   // Last drag.
   bool have_drag = false;
-  Eigen::MatrixXd X1;        // nL by 3: stage-1 positions (displaced frame)
+  Eigen::MatrixXd U1;        // nL by 3: stage-1 displacements from the displaced rest mesh Vd
   Eigen::MatrixXd known;     // nK by 3: known positions in the original frame
   Eigen::MatrixXd soft_u;    // nU by 3: soft targets in the original frame (rows with soft > 0)
   std::vector<Eigen::Matrix3d> linear;  // per handle: linear part used by the last drag
@@ -127,11 +133,20 @@ struct LaplacianEditor::Impl {
   // handle_basis.cpp: per-handle responses Φ (superposition of Eq. 7 solutions).
   Status build_handle_basis(edit_detail::EditBuild& s, const Progress& progress);
 
-  Status solve_stage1(const Eigen::MatrixXd& known_d, const Eigen::MatrixXd& soft_d,
-                      const std::vector<Eigen::Matrix3d>& linear, const std::vector<Eigen::Vector3d>* translation);
-  EditResult output_stage1();
+  // Aᵀ(b − A Y) of Eq. 7 for m columns at once (the same A for each column, Sec. 6). Y: nL by m
+  // (unknowns, then known values); grad_rhs: per handle 3 by m right-hand side of its
+  // gradient-constraint rows per stencil direction c (empty without gradient constraints);
+  // soft_target: nU by m (rows with soft > 0 read; empty without soft constraints). nU by m.
+  void stage1_normal_residual(const Eigen::MatrixXd& Y, const std::vector<Eigen::MatrixXd>& grad_rhs,
+                              const Eigen::MatrixXd& soft_target, Eigen::MatrixXd* g) const;
+  // Stage 1 for known displacements u_K (nK by 3, displaced frame), soft target displacements
+  // (nU by 3 or empty) and the handles' linear parts; with `translation`, by the handle basis.
+  Status solve_stage1(const Eigen::MatrixXd& known_u, const Eigen::MatrixXd& soft_u_d,
+                      const std::vector<Eigen::Matrix3d>& linear, const std::vector<Eigen::Vector3d>* translation,
+                      int* refinements);
+  EditResult output_stage1(int refinements);
   EditResult solve_stage2(bool use_rotations, FeatureSize mode);
-  Eigen::Matrix3d gradient_local(int l) const;  // M of unknown l from X1
+  Eigen::Matrix3d gradient_local(int l) const;  // M of unknown l from U1 (I + Σ u_k w_kᵀ)
 };
 
 }  // namespace mm

@@ -9,7 +9,7 @@ namespace mm {
 
 // For well-conditioned, orientation-preserving M the closed form R = M V diag(1/σ) Vᵀ from the
 // eigen-decomposition of MᵀM (closed-form 3x3 eigen solver) is ~10× faster than a Jacobi SVD
-// and agrees with it to ~1e-12; near-singular (σ3² < 1e-6 σ1²) or reflected M go through
+// and, after one Newton polar step, agrees with it to ~1e-15; near-singular (σ3² < 1e-6 σ1²) or reflected M go through
 // linalg/polar.h (which moves the reflection into S). Non-finite M gives the identity.
 Eigen::Matrix3d rotation_part(const Eigen::Matrix3d& M);
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "linalg/iterative_refinement.h"
 #include "mesh/topology.h"
 
 namespace mm {
@@ -112,6 +113,15 @@ Status LaplacianEditor::Impl::build_similarity_system(EditBuild& s, const Progre
     }
   }
   stats.coherence_pairs = static_cast<int>(partners.size() / 2);
+  // Kept for the matrix-free residuals of the refinement (stage1_normal_residual).
+  pair_center.resize(nP);
+  pair_active.resize(nP);
+  for (int p = 0; p < nP; ++p) {
+    pair_center[p] = center_index[pair_centers[p]];
+    pair_active[p] = is_active[pair_center[p]];
+  }
+  this->partner_ptr = partner_ptr;
+  this->partners = partners;
   // Y_a for active centers, as sparse lists (local vertex, 3-vector).
   std::vector<double> acc3(3 * static_cast<size_t>(nL), 0.0);
   std::vector<int> mark(nL, -1), touched;
@@ -163,26 +173,24 @@ Status LaplacianEditor::Impl::build_similarity_system(EditBuild& s, const Progre
       }
     }
   }
-  // Transformation-constraint rows (Eq. 7) at handle vertices whose gradient has an unknown.
+  // Transformation-constraint rows (Eq. 7) at handle vertices whose gradient has an unknown (their
+  // right-hand side, the handle's linear part, enters through stage1_normal_residual).
   const double wg = opt.gradient_constraint_weight;
-  G1 = Eigen::MatrixXd::Zero(nU, 3 * num_handles);
   std::vector<char> grad_row(nP, 0);
+  pair_handle.assign(nP, -1);
   if (wg > 0)
     for (int p = 0; p < nP; ++p) {
       const int v = pair_centers[p], c = center_index[v];
       if (gid[v] < 0 || !is_active[c]) continue;
       grad_row[p] = 1;
-      for (int e = grads.offsets[c]; e < grads.offsets[c + 1]; ++e)
-        if (stencil_local[e] < nU)
-          for (int k = 0; k < 3; ++k) G1(stencil_local[e], 3 * gid[v] + k) += wg * grads.weights(e, k);
+      pair_handle[p] = gid[v];
     }
   const Eigen::SparseMatrix<double, Eigen::RowMajor> Erow = E;  // rows of E
   const EditSparse& Ecol = E;                                        // columns of E
-  // Columns of N = AᵀA for the unknowns: lower part of N_UU and the block N_UK (as rows).
+  // Columns of N = AᵀA for the unknowns: lower part of N_UU. (The known columns N_UK are not
+  // needed: right-hand sides are residuals of the unsquared system.)
   EditSparse NUU(nU, nU);
-  Eigen::SparseMatrix<double, Eigen::RowMajor> QR(nU, nL - nU);
   NUU.reserve(static_cast<Eigen::Index>(nU) * 40);
-  QR.reserve(static_cast<Eigen::Index>(nU) * 8);
   std::vector<double> acc(nL, 0.0);
   std::fill(mark.begin(), mark.end(), -1);
   for (int i = 0; i < nU; ++i) {
@@ -212,15 +220,11 @@ Status LaplacianEditor::Impl::build_similarity_system(EditBuild& s, const Progre
     if (soft[i] > 0) add(i, soft[i]);
     std::sort(touched.begin(), touched.end());
     NUU.startVec(i);
-    QR.startVec(i);
-    for (int j : touched) {
-      if (j >= nU) QR.insertBack(i, j - nU) = acc[j];
-      else if (j >= i) NUU.insertBack(j, i) = acc[j];
-    }
+    for (int j : touched)
+      if (j >= i && j < nU) NUU.insertBack(j, i) = acc[j];
   }
   NUU.finalize();
-  QR.finalize();
-  Q1 = QR;
+  E1 = std::move(E);
 
   stats.system_nonzeros = static_cast<long>(NUU.nonZeros());
   stats.assembly_ms = edit_lap_ms(&clock);
@@ -237,54 +241,162 @@ Status LaplacianEditor::Impl::build_similarity_system(EditBuild& s, const Progre
 }
 
 Eigen::Matrix3d LaplacianEditor::Impl::gradient_local(int l) const {
+  // M(Vd + U) = I + M(U): Σ_k v'_k w_kᵀ = I on the displaced rest mesh (Eq. 4), so only the
+  // displacements need summing (exact for the identity, and no cancellation of large coordinates).
   const int c = center_of[l];
-  Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d M = Eigen::Matrix3d::Identity();
   for (int e = grads.offsets[c]; e < grads.offsets[c + 1]; ++e)
-    M.noalias() += X1.row(stencil_local[e]).transpose() * grads.weights.row(e);
+    M.noalias() += U1.row(stencil_local[e]).transpose() * grads.weights.row(e);
   return M;
 }
 
-Status LaplacianEditor::Impl::solve_stage1(const Eigen::MatrixXd& known_d, const Eigen::MatrixXd& soft_d,
-                                           const std::vector<Eigen::Matrix3d>& linear_parts,
-                                           const std::vector<Eigen::Vector3d>* translation) {
-  linear = linear_parts;
-  X1.resize(nL, 3);
-  X1.bottomRows(nL - nU) = known_d;
-  Eigen::MatrixXd xU;
-  if (translation && have_basis) {
-    // Superposition of the precomputed responses: x_U = Φ_0 + Σ_h Φ_h [A_h t_h]ᵀ.
-    xU = Phi0;
-    for (int h = 0; h < num_handles; ++h) {
-      Eigen::Matrix<double, 4, 3> T;
-      T.topRows(3) = linear_parts[h].transpose();
-      T.row(3) = (*translation)[h].transpose();
-      xU.noalias() += Phi[h] * T;
+// The residual of the normal equations formed from A itself, never from the assembled AᵀA (whose
+// rounding is what the refinement removes). Rows of A (for one column y, Sec. 6):
+//   E_L (Eq. 5):        (E1 y)_i                               right-hand side 0
+//   E_R (Eq. 6):        √cw (m_a(y) − m_b(y))_c, pairs {a, b}  right-hand side 0
+//   Eq. 7 gradients:    √wg (m_p(y))_c                          right-hand side √wg B_h(c)
+//   soft constraints:   √soft_i y_i                             right-hand side √soft_i t_i
+// with m_a(y) = Σ_k w_k y_k over the stencil of a (a 3-vector: row r of M_a for coordinate r).
+// Hence Aᵀ(b − A y) = −E1ᵀ E1 y − cw Σ_a K_a Z_a − wg Σ_p K_p (m_p − B_h) + soft (t − y), with
+// Z_a = Σ_{b ~ a} (m_a − m_b) over a's partners (each unordered pair is listed from both ends).
+namespace {
+
+// The E_R and gradient-constraint part of stage1_normal_residual over row-major m-column blocks.
+// M = m at compile time (3: a drag, 4 or 8: the basis of 1 or 2 handles) lets the compiler unroll
+// and vectorise the 3-by-m block loops (they are most of the residual's cost); 0 = any m.
+struct ResidualPairs {
+  int nP, nU, m;
+  const int *pair_center, *offsets, *stencil_local, *partner_ptr, *partners, *pair_handle;
+  const char* pair_active;
+  const double* weights;  // column-major #entries by 3
+  long wstride;
+  double cw, wg;
+  const std::vector<Eigen::MatrixXd>* grad_rhs;
+};
+
+template <int M>
+void residual_pairs(const ResidualPairs& a, const double* Y, double* Mg, double* G) {
+  const int m = M > 0 ? M : a.m;
+  for (int p = 0; p < a.nP; ++p) {
+    const int c = a.pair_center[p];
+    double* M0 = Mg + 3 * static_cast<long>(p) * m;
+    double *M1 = M0 + m, *M2 = M1 + m;
+    for (int e = a.offsets[c]; e < a.offsets[c + 1]; ++e) {
+      const double w0 = a.weights[e], w1 = a.weights[e + a.wstride], w2 = a.weights[e + 2 * a.wstride];
+      const double* y = Y + static_cast<long>(a.stencil_local[e]) * m;
+      for (int k = 0; k < m; ++k) {
+        M0[k] += w0 * y[k];
+        M1[k] += w1 * y[k];
+        M2[k] += w2 * y[k];
+      }
     }
-  } else {
-    // Eliminated hard constraints: AᵀA x_U = −N_UK x_K (+ soft and gradient-constraint terms),
-    // one back-substitution per coordinate (Sec. 6).
-    Eigen::MatrixXd rhs = -(Q1 * known_d);
-    for (int l = 0; l < nU; ++l)
-      if (soft[l] > 0) rhs.row(l) += soft[l] * soft_d.row(l);
-    for (int h = 0; h < num_handles; ++h) rhs.noalias() += G1.block(0, 3 * h, nU, 3) * linear_parts[h].transpose();
-    if (Status s = solver1.solve(rhs, &xU); !s.ok()) return s;
   }
-  X1.topRows(nU) = xU;
+  std::vector<double> Zbuf(3 * static_cast<size_t>(m));
+  double* Z = Zbuf.data();
+  for (int p = 0; p < a.nP; ++p) {
+    if (!a.pair_active[p]) continue;  // its stencil has no unknown: no column of A_U to feed
+    const double* Mp = Mg + 3 * static_cast<long>(p) * m;
+    const int deg = a.partner_ptr[p + 1] - a.partner_ptr[p];
+    // Z = Σ_q (M_p − M_q) = deg·M_p − Σ_q M_q (the sum first: fewer operations per partner).
+    for (int k = 0; k < 3 * m; ++k) Z[k] = 0.0;
+    for (int q = a.partner_ptr[p]; q < a.partner_ptr[p + 1]; ++q) {
+      const double* Mq = Mg + 3 * static_cast<long>(a.partners[q]) * m;
+      for (int k = 0; k < 3 * m; ++k) Z[k] += Mq[k];
+    }
+    for (int k = 0; k < 3 * m; ++k) Z[k] = a.cw * (deg * Mp[k] - Z[k]);
+    if (a.pair_handle[p] >= 0) {
+      const Eigen::MatrixXd& B = (*a.grad_rhs)[a.pair_handle[p]];  // 3 by m
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < m; ++k) Z[r * m + k] += a.wg * (Mp[r * m + k] - B(r, k));
+    }
+    const int c = a.pair_center[p];
+    for (int e = a.offsets[c]; e < a.offsets[c + 1]; ++e) {
+      const int j = a.stencil_local[e];
+      if (j >= a.nU) continue;
+      const double w0 = a.weights[e], w1 = a.weights[e + a.wstride], w2 = a.weights[e + 2 * a.wstride];
+      double* gj = G + static_cast<long>(j) * m;
+      for (int k = 0; k < m; ++k) gj[k] -= w0 * Z[k] + w1 * Z[m + k] + w2 * Z[2 * m + k];
+    }
+  }
+}
+
+}  // namespace
+
+void LaplacianEditor::Impl::stage1_normal_residual(const Eigen::MatrixXd& Y, const std::vector<Eigen::MatrixXd>& grad_rhs,
+                                                   const Eigen::MatrixXd& soft_target, Eigen::MatrixXd* g) const {
+  using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const int m = static_cast<int>(Y.cols());
+  const int nP = static_cast<int>(pair_center.size());
+  const Eigen::MatrixXd EY = E1 * Y;
+  RowMat G = -(E1.transpose() * EY).topRows(nU);
+  const RowMat Yr = Y;
+  RowMat Mg = RowMat::Zero(3 * static_cast<Eigen::Index>(nP), m);
+  const ResidualPairs a{nP, nU, m, pair_center.data(), grads.offsets.data(), stencil_local.data(), partner_ptr.data(),
+                        partners.data(), pair_handle.data(), pair_active.data(), grads.weights.data(),
+                        static_cast<long>(grads.weights.rows()), opt.coherence_weight, opt.gradient_constraint_weight,
+                        &grad_rhs};
+  if (m == 3) residual_pairs<3>(a, Yr.data(), Mg.data(), G.data());
+  else if (m == 4) residual_pairs<4>(a, Yr.data(), Mg.data(), G.data());
+  else if (m == 8) residual_pairs<8>(a, Yr.data(), Mg.data(), G.data());
+  else residual_pairs<0>(a, Yr.data(), Mg.data(), G.data());
+  if (soft_target.size())
+    for (int l = 0; l < nU; ++l)
+      if (soft[l] > 0) G.row(l) += soft[l] * (soft_target.row(l) - Y.row(l));
+  *g = G;
+}
+
+Status LaplacianEditor::Impl::solve_stage1(const Eigen::MatrixXd& known_u, const Eigen::MatrixXd& soft_u_d,
+                                           const std::vector<Eigen::Matrix3d>& linear_parts,
+                                           const std::vector<Eigen::Vector3d>* translation, int* refinements) {
+  linear = linear_parts;
+  *refinements = 0;
+  U1.resize(nL, 3);
+  U1.bottomRows(nL - nU) = known_u;
+  if (translation && have_basis) {
+    // Superposition of the precomputed (refined) responses: u_U = Σ_h Φ_h [(A_h − I) τ_h]ᵀ.
+    Eigen::MatrixXd uU = Eigen::MatrixXd::Zero(nU, 3);
+    for (int h = 0; h < num_handles; ++h) {
+      const Eigen::Matrix3d B = linear_parts[h] - Eigen::Matrix3d::Identity();
+      Eigen::Matrix<double, 4, 3> T;
+      T.topRows(3) = B.transpose();
+      T.row(3) = (B * handle_center[h] + (*translation)[h]).transpose();
+      uU.noalias() += Phi[h] * T;
+    }
+    U1.topRows(nU) = uU;
+    return Status::success();
+  }
+  // Eliminated hard constraints, one column per coordinate (Sec. 6): the first solve and its
+  // refinements all use residuals of the unsquared system.
+  std::vector<Eigen::MatrixXd> grad_rhs;
+  if (opt.gradient_constraint_weight > 0)
+    for (int h = 0; h < num_handles; ++h) grad_rhs.push_back((linear_parts[h] - Eigen::Matrix3d::Identity()).transpose());
+  Eigen::MatrixXd Y = U1, x = Eigen::MatrixXd::Zero(nU, 3);
+  const IterativeRefinementReport rep = refine_solution(
+      [&](const Eigen::MatrixXd& xx, Eigen::MatrixXd* g) {
+        Y.topRows(nU) = xx;
+        stage1_normal_residual(Y, grad_rhs, soft_u_d, g);
+      },
+      [&](Eigen::MatrixXd* r) { solver1.solve_in_place(*r); }, &x, opt.residual_refinements);
+  if (!rep.status.ok()) return rep.status;
+  U1.topRows(nU) = x;
+  *refinements = rep.steps;
   return Status::success();
 }
 
-EditResult LaplacianEditor::Impl::output_stage1() {
+EditResult LaplacianEditor::Impl::output_stage1(int refinements) {
   EditResult out;
+  out.refinements = refinements;
   out.V = V;
-  for (int l = 0; l < nU; ++l) out.V.row(l2g[l]) = X1.row(l);
+  // Unknowns: rest + displacement (Vd = V where nothing was displaced).
+  for (int l = 0; l < nU; ++l) out.V.row(l2g[l]) += U1.row(l);
   for (int k = 0; k < nL - nU; ++k) out.V.row(l2g[nU + k]) = known.row(k);
-  // Pull-back of displaced free vertices (Sec. 3.3): ṽ = M (v − v') + ṽ'. A soft-constrained one
-  // uses its handle's linear part instead (its target was set as A v' + t), so that soft
-  // constraints tend to hard ones as their weight grows.
+  // Pull-back of displaced free vertices (Sec. 3.3): ṽ = M (v − v') + ṽ' = v + u + (M − I)(v − v').
+  // A soft-constrained one uses its handle's linear part instead (its target was set as A v' + t),
+  // so that soft constraints tend to hard ones as their weight grows.
   for (int l : displaced_unknowns) {
     const int v = l2g[l], g = group[l];
     const Eigen::Matrix3d M = g == -2 ? gradient_local(l) : g == -1 ? Eigen::Matrix3d::Identity() : linear[g];
-    out.V.row(v) = (X1.row(l).transpose() + M * (V.row(v) - Vd.row(v)).transpose()).transpose();
+    out.V.row(v) = (V.row(v) + U1.row(l)).transpose() + (M - Eigen::Matrix3d::Identity()) * (V.row(v) - Vd.row(v)).transpose();
   }
   if (!out.V.allFinite())
     out.status = Status::error(StatusCode::NumericalError, "the editing solve produced non-finite positions");
