@@ -420,8 +420,19 @@ export const panel = {
     app.on('ready', async () => {
       try {
         const schema = (await client.run('optionSchema', { job: 'transfer' }).promise).info;
-        // The method has its own selector above the form.
-        form = new OptionsForm(schema.options.filter((o) => o.name !== 'method'), { title: 'Options' });
+        // The method has its own selector above the form: its choices, default and help come
+        // from the schema too (the labels above only name the papers).
+        const method = schema.options.find((o) => o.name === 'method');
+        if (method) {
+          const select = $('tr-method');
+          for (const choice of method.choices || []) {
+            if (![...select.options].some((o) => o.value === choice)) select.add(new Option(choice, choice));
+          }
+          for (const o of [...select.options]) if (!(method.choices || []).includes(o.value)) o.remove();
+          select.value = method.default;
+          select.title = method.help;
+        }
+        form = new OptionsForm(schema.options.filter((o) => o.name !== 'method'), { title: 'Transfer options' });
         $('tr-options').append(form.element);
       } catch (e) {
         app.showError(e);
