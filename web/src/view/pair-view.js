@@ -2,14 +2,19 @@
 // the source — or the transfer result — on the right). Each side is a THREE.Mesh with its own
 // VertexPicker (view/picking.js); both are scaled to the same display size (their bounding
 // radius → 1) and placed next to each other, so meshes in different units are comparable.
-// One camera and the viewer's orbit controls look at both; a pick tries both sides and keeps
-// the nearer hit. Points given to and returned by this module are world space unless named
-// `local` (a side's own coordinates, where its markers live as children of its mesh).
+// Three ways to show them (setMode):
+//   'side'    side by side in one pane, one camera; a pick tries both and keeps the nearer hit
+//   'split'   two panes (Viewer.setSplit), the reference left and the source right, each centred
+//             with its own camera; the cameras are linked (orbiting one moves both) or not
+//   'overlay' both at the same place in one pane, the source see-through
+// Points given to and returned by this module are world space unless named `local` (a side's
+// own coordinates, where its markers live as children of its mesh).
 import * as THREE from 'three';
 import { applyArrays } from '../lib/arrays.js';
 import { VertexPicker, ndcFromClient } from './picking.js';
 
 export const sides = ['reference', 'source'];
+export const modes = ['side', 'split', 'overlay'];
 const sideColors = { reference: 0xb9c7e0, source: 0xd8cdbf };
 const gap = 0.2; // between the two meshes' bounding spheres, in display radii
 
@@ -33,6 +38,8 @@ export class PairView {
     this.sides = Object.fromEntries(sides.map((name) => [name, createSide(name)]));
     for (const side of Object.values(this.sides)) this.group.add(side.mesh);
     this.raycaster = new THREE.Raycaster();
+    this.mode = 'side';
+    this.linked = true;
   }
 
   get active() { return this.group.visible; }
@@ -42,8 +49,47 @@ export class PairView {
     if (this.group.visible === on) return;
     this.group.visible = on;
     this.viewer.setMainVisible(!on);
+    this.applySplit();
     if (on) this.frame();
     this.viewer.requestRender();
+  }
+
+  // 'side' | 'split' | 'overlay' (see above); linked: the split panes' cameras move together.
+  setMode(mode, { linked = this.linked } = {}) {
+    if (!modes.includes(mode)) throw new Error(`unknown pair view mode ${mode}`);
+    const changed = mode !== this.mode;
+    this.mode = mode;
+    this.linked = linked;
+    const source = this.sides.source.mesh.material;
+    source.transparent = mode === 'overlay';
+    source.opacity = mode === 'overlay' ? 0.5 : 1;
+    source.depthWrite = mode !== 'overlay';
+    source.needsUpdate = true;
+    this.layout();
+    this.applySplit();
+    if (changed) this.frame();
+    this.viewer.requestRender();
+  }
+
+  applySplit() {
+    const { viewer } = this;
+    const split = this.active && this.mode === 'split';
+    if (!split) {
+      if (viewer.split) viewer.setSplit(null);
+      return;
+    }
+    const meshes = sides.map((name) => this.sides[name]);
+    viewer.setSplit({
+      linked: this.linked,
+      beforePass: (i) => meshes.forEach((side, k) => { side.mesh.visible = side.loaded && k === i; }),
+      afterPasses: () => meshes.forEach((side) => { side.mesh.visible = side.loaded; }),
+    });
+  }
+
+  // Which pane shows a side (0 unless split) and its camera and client rectangle.
+  view(name) {
+    const pane = this.mode === 'split' && this.active && name === 'source' ? 1 : 0;
+    return { pane, camera: this.viewer.paneCamera(pane), rect: this.viewer.paneRect(pane) };
   }
 
   // A mesh for one side: positions/normals/indices (+ toWelded) from a load result; `open` as
@@ -84,6 +130,7 @@ export class PairView {
   // Display size: both sides scaled to bounding radius 1 and centred on their bounding boxes,
   // the reference at x = -(1 + gap / 2), the source at x = +(1 + gap / 2): fixed places, so
   // switching the source for the result (another extent) does not move the other side.
+  // In split and overlay modes both are centred on the origin.
   layout() {
     for (const side of Object.values(this.sides)) {
       const geometry = side.mesh.geometry;
@@ -92,7 +139,7 @@ export class PairView {
       const center = geometry.boundingBox.getCenter(new THREE.Vector3());
       side.mesh.scale.setScalar(scale);
       side.mesh.position.copy(center).multiplyScalar(-scale);
-      side.mesh.position.x += (side.name === 'reference' ? -1 : 1) * (1 + gap / 2);
+      if (this.mode === 'side') side.mesh.position.x += (side.name === 'reference' ? -1 : 1) * (1 + gap / 2);
     }
     this.group.updateMatrixWorld(true);
   }
@@ -100,19 +147,28 @@ export class PairView {
   frame() {
     const meshes = Object.values(this.sides).filter((s) => s.loaded).map((s) => s.mesh);
     // Straight from the front (slightly above): both sides at the same distance, the same size.
-    if (meshes.length && this.active) this.viewer.frameMeshes(meshes, { direction: [0, 0.3, 1] });
+    // Split panes frame both meshes (they share the place), so linked cameras agree.
+    if (!meshes.length || !this.active) return;
+    this.viewer.frameMeshes(meshes, { direction: [0, 0.3, 1] });
+    if (this.mode === 'split') this.viewer.frameMeshes(meshes, { direction: [0, 0.3, 1], pane: 1 });
   }
 
   // The vertex under a pointer position on either side: the picking.js result plus `side`, or
   // null. Both sides are ray cast; the nearer hit wins.
   pickAt(clientX, clientY) {
     if (!this.active) return null;
-    const { camera, renderer } = this.viewer;
-    const [x, y] = ndcFromClient(clientX, clientY, renderer.domElement.getBoundingClientRect());
+    let candidates = Object.values(this.sides);
+    let pane = 0;
+    if (this.mode === 'split') {
+      pane = clientX >= this.viewer.paneRect(1).left ? 1 : 0;
+      candidates = [candidates[pane]];
+    }
+    const camera = this.viewer.paneCamera(pane);
+    const [x, y] = ndcFromClient(clientX, clientY, this.viewer.paneRect(pane));
     camera.updateMatrixWorld();
     this.raycaster.setFromCamera(new THREE.Vector2(x, y), camera);
     let best = null;
-    for (const side of Object.values(this.sides)) {
+    for (const side of candidates) {
       if (!side.loaded) continue;
       const pick = side.picker.pickRay(this.raycaster.ray);
       if (pick && (!best || pick.distance < best.distance)) best = { ...pick, side: side.name };

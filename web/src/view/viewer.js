@@ -18,6 +18,9 @@ import { VertexMarker } from './marker.js';
 import { VertexPicker, ndcFromClient } from './picking.js';
 
 export const backgroundColor = 0x1d2230;
+// Above this many displayed vertices the picking BVH is not built: its build (seconds on the
+// main thread for a million vertices) would freeze the page.
+export const maxPickVertices = 400000;
 const surfaceColor = 0xc9cfd8;
 
 export class Viewer {
@@ -245,6 +248,8 @@ export class Viewer {
     this.frame();
     // Build the picking BVH when the page is idle (~0.1–0.3 s for 50k vertices), not on the
     // first hover; a pick before that builds it itself.
+    this.pickable = positions.length / 3 <= maxPickVertices;
+    if (!this.pickable) return;
     const schedule = window.requestIdleCallback || ((fn) => setTimeout(fn, 0));
     schedule(() => {
       if (this.geometry === geometry) this.picker.ensureBvh();
@@ -283,7 +288,7 @@ export class Viewer {
   }
 
   pickAt(clientX, clientY) {
-    if (!this.geometry.getAttribute('position') || !this.mesh.visible) return null;
+    if (!this.geometry.getAttribute('position') || !this.mesh.visible || !this.pickable) return null;
     const [x, y] = ndcFromClient(clientX, clientY, this.renderer.domElement.getBoundingClientRect());
     this.camera.updateMatrixWorld();
     return this.picker.pickNdc(x, y, this.camera);

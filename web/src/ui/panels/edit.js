@@ -469,6 +469,15 @@ export const panel = {
       refresh();
     });
     app.on('mesh', (mesh) => newMesh(mesh));
+    // A replaced worker has the meshes again but not the edit session: back to the selection
+    // (the painted sets stay).
+    app.on('restarted', () => {
+      if (!edit.session) return;
+      edit.session = false; // nothing to dispose in the new worker
+      endSession();
+      refresh();
+      updateBrush();
+    });
     app.on('job', (job) => {
       const was = visible;
       visible = job === 'edit';
