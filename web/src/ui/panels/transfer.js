@@ -266,11 +266,14 @@ export const panel = {
       const sample = samples.find((s) => s.id === id);
       if (!sample) return false;
       $(`tr-${side}-sample`).value = id;
+      transfer.loading = side; // already while the files are fetched (drops wait for it)
       try {
         return await loadSide(side, await sampleFiles(sample));
       } catch (e) {
         app.showError(e);
         return false;
+      } finally {
+        transfer.loading = null;
       }
     }
 
@@ -443,6 +446,10 @@ export const panel = {
       describe: (x) => `Drop here to open the ${dropSide(x)} (${dropSide(x) === 'reference' ? 'left' : 'right'} half)`,
       async drop(fileList, x) {
         const side = dropSide(x);
+        if (transfer.loading) {
+          app.showError({ code: 'Busy', message: `the ${transfer.loading} is still loading: the dropped file was not opened. Drop it again when it has loaded.` });
+          return;
+        }
         try {
           if (await loadSide(side, await userFiles(fileList))) $(`tr-${side}-sample`).value = 'file';
         } catch (e) {
@@ -571,6 +578,9 @@ export const panel = {
 
     app.hooks.transferVertexOnScreen = (side, vertex) => vertexOnScreen(viewer, vertex, { ...pair.sides[side], ...pair.view(side) });
     app.hooks.transferLabels = () => markers.labels();
+    app.hooks.transferCameras = () => [0, 1].map((i) => ({
+      position: viewer.paneCamera(i).position.toArray(), target: (i ? viewer.controls2 : viewer.controls).target.toArray(),
+    }));
     // Welded → raw for a side (tests place the pointer on displayed vertices).
     app.hooks.transferRawVertex = (side, welded) => meshes[side]?.weldedToRaw[welded] ?? -1;
     app.hooks.transferResult = () => (result ? Array.from(result) : null);
