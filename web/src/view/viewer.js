@@ -305,9 +305,10 @@ export class Viewer {
 
   // New positions for the shown mesh (#R·3, raw layout; same triangles), e.g. an edit preview:
   // updated in place, normals recomputed, the picking BVH refitted at the next pick.
-  setPositions(positions) {
-    applyArrays(this.geometry, { positions });
-    this.geometry.computeVertexNormals();
+  // `normals` (same layout) when the caller has them (the worker computes them for edits).
+  setPositions(positions, normals = null) {
+    applyArrays(this.geometry, { positions, normals });
+    if (!normals) this.geometry.computeVertexNormals();
     this.picker.refitLater();
     this.requestRender();
   }
