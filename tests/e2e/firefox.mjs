@@ -6,8 +6,9 @@
 //
 // Differences handled here: downloads are captured in the page (an anchor with `download`
 // records its name and blob instead of opening Firefox's download flow); file inputs take
-// uploadFile(); console type 'warn' is playwright's 'warning'; no long-task observer
-// (Firefox has no 'longtask' entries), so those figures are Chromium's only.
+// uploadFile(); buttons are clicked through the DOM (the canvas gets real pointer events from
+// page.mouse); console type 'warn' is playwright's 'warning'; no long-task observer (Firefox
+// has no 'longtask' entries), so those figures are Chromium's only.
 import { spawn } from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
@@ -94,7 +95,16 @@ export class PlaywrightLikePage {
     return this.page.waitForSelector(selector, { visible: state === 'visible', hidden: state === 'hidden', timeout });
   }
 
-  click(selector) { return this.page.click(selector); }
+  // A DOM click on the element (scrolled into view): the side panel scrolls, and pointer
+  // clicks at computed positions are what the canvas tests use page.mouse for.
+  async click(selector) {
+    await this.page.waitForSelector(selector, { timeout: 30000 });
+    await this.page.evaluate((s) => {
+      const el = document.querySelector(s);
+      el.scrollIntoView({ block: 'nearest' });
+      el.click();
+    }, selector);
+  }
 
   selectOption(selector, value) { return this.page.select(selector, value); }
 

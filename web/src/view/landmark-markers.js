@@ -5,7 +5,9 @@
 // larger, the pending half of a pair (clicked on one side, waiting for the other) in white.
 // Numbers are sprites drawn on top (no depth test, so the surface never cuts them), and so
 // an occlusion check hides the number of a vertex the camera does not see (a BVH ray from the
-// camera, view/screen-space.js) before every frame: numbers never show through the mesh.
+// camera, view/screen-space.js; a vertex a few percent of the mesh's size behind the surface,
+// like the underside of a paw's tip, counts as seen) before every frame: numbers never show
+// through the mesh.
 // Suggested pairs (not accepted yet) are drawn as rings with their number in a dark disc.
 import * as THREE from 'three';
 import { VertexMarker } from './marker.js';
@@ -18,6 +20,9 @@ export function pairColor(i) {
 }
 
 const pendingColor = [1, 1, 1];
+// A number shows when the first surface point on the line of sight to its vertex is at most
+// this far (relative to the mesh's radius) in front of it.
+export const labelTolerance = 0.04;
 const labelPx = 64;
 
 // A sprite showing `text` on a disc of colour `rgb`.
@@ -65,7 +70,7 @@ export class LandmarkMarkers {
     if (!view.active) return;
     for (const item of [...this.items, ...this.suggestions]) {
       const side = view.sides[item.side];
-      item.label.visible = vertexVisible(view.viewer, item.vertex, { mesh: side.mesh, picker: side.picker, camera: view.view(item.side).camera });
+      item.label.visible = vertexVisible(view.viewer, item.vertex, { mesh: side.mesh, picker: side.picker, camera: view.view(item.side).camera, tolerance: labelTolerance });
     }
   }
 

@@ -35,7 +35,10 @@ export function projectVertices(viewer) {
 
 // True when the raw vertex is the first surface point the camera sees along its line of sight
 // (within a small tolerance of the scene's size).
-export function vertexVisible(viewer, vertex, { mesh = viewer.mesh, picker = viewer.picker, camera = viewer.camera } = {}) {
+// `tolerance`: how far (relative to the mesh's bounding radius) the first surface point may lie
+// in front of the vertex (landmark numbers use a few percent, so the tip of a paw seen from
+// above still counts as seen).
+export function vertexVisible(viewer, vertex, { mesh = viewer.mesh, picker = viewer.picker, camera = viewer.camera, tolerance: relative = 1e-3 } = {}) {
   const bvh = picker.ensureBvh();
   if (!bvh) return false;
   const p = mesh.geometry.getAttribute('position').array;
@@ -49,7 +52,7 @@ export function vertexVisible(viewer, vertex, { mesh = viewer.mesh, picker = vie
   if (!(distance > 0)) return false;
   ray.direction.divideScalar(distance);
   const hit = bvh.raycastFirst(ray, THREE.DoubleSide);
-  const tolerance = 1e-3 * (mesh.geometry.boundingSphere?.radius || 1);
+  const tolerance = relative * (mesh.geometry.boundingSphere?.radius || 1);
   return !hit || hit.distance >= distance - tolerance;
 }
 
@@ -66,5 +69,5 @@ export function vertexOnScreen(viewer, vertex, target = {}) {
   const x = rect.left + ((ndc.x + 1) / 2) * rect.width;
   const y = rect.top + ((1 - ndc.y) / 2) * rect.height;
   const inView = Math.abs(ndc.x) < 1 && Math.abs(ndc.y) < 1 && Math.abs(ndc.z) < 1;
-  return { x, y, visible: inView && mesh.visible && vertexVisible(viewer, vertex, { mesh, picker: target.picker ?? viewer.picker, camera }) };
+  return { x, y, visible: inView && mesh.visible && vertexVisible(viewer, vertex, { mesh, picker: target.picker ?? viewer.picker, camera, tolerance: target.tolerance }) };
 }

@@ -21,7 +21,7 @@ import { unweldValues } from '../../lib/arrays.js';
 import { LandmarkPairs, landmarkFile, minLandmarks, readLandmarkFile } from '../../lib/landmarks.js';
 import { samples } from '../../lib/samples.js';
 import { weldedTriangles } from '../../lib/vertex-sets.js';
-import { LandmarkMarkers, pairColor } from '../../view/landmark-markers.js';
+import { LandmarkMarkers, labelTolerance, pairColor } from '../../view/landmark-markers.js';
 import { VertexMarker } from '../../view/marker.js';
 import { PairView } from '../../view/pair-view.js';
 import { attachPointerPicking } from '../../view/pointer-picking.js';
@@ -431,7 +431,7 @@ export const panel = {
     const paneLabels = fromHtml('<div class="pane-labels" hidden><span>Reference</span><span>Source</span></div>');
     viewer.renderer.domElement.after(paneLabels);
     function showPaneLabels() {
-      paneLabels.hidden = !visible || transfer.view === 'overlay';
+      paneLabels.hidden = !visible || transfer.view !== 'split';
       paneLabels.classList.toggle('split', transfer.view === 'split');
     }
 
@@ -576,7 +576,9 @@ export const panel = {
     // A mesh loaded in the Mesh job frames the camera on it; while the pair is shown, frame it.
     app.on('mesh', () => { if (visible) pair.frame(); });
 
-    app.hooks.transferVertexOnScreen = (side, vertex) => vertexOnScreen(viewer, vertex, { ...pair.sides[side], ...pair.view(side) });
+    // tolerance: see view/screen-space.js vertexVisible (labels use labelTolerance).
+    app.hooks.transferVertexOnScreen = (side, vertex, tolerance = undefined) => vertexOnScreen(viewer, vertex, { ...pair.sides[side], ...pair.view(side), tolerance });
+    app.hooks.labelTolerance = labelTolerance;
     app.hooks.transferLabels = () => markers.labels();
     app.hooks.transferCameras = () => [0, 1].map((i) => ({
       position: viewer.paneCamera(i).position.toArray(), target: (i ? viewer.controls2 : viewer.controls).target.toArray(),
