@@ -1099,6 +1099,26 @@ it('transfer: the cat pair side by side, run and compare; landmark pairs clicked
   await nextFrame(page);
   await shot(page, '12-transfer-8-suggestions-accepted');
 
+  // glTF meshes in the pair show their own materials (the Fox's texture), the toggle gives
+  // the plain colours.
+  await page.selectOption('#tr-reference-sample', 'fox');
+  await page.waitForFunction(() => window.__meshmorph.state.transfer.reference?.name === 'Fox.gltf' || window.__meshmorph.state.error, null, { timeout: 30000 });
+  await page.selectOption('#tr-source-sample', 'cesiumman');
+  await page.waitForFunction(() => window.__meshmorph.state.transfer.source?.name === 'CesiumMan.glb' || window.__meshmorph.state.error, null, { timeout: 30000 });
+  await waitIdle(page);
+  await page.waitForFunction(() => Object.values(window.__meshmorph.hooks.transferMaterials()).every((m) => m === 'document'), null, { timeout: 30000 })
+    .catch(async () => { throw new Error(`pair materials: ${JSON.stringify(await page.evaluate(() => window.__meshmorph.hooks.transferMaterials()))}`); });
+  let foxTexture = 0;
+  for (let i = 0; i < 20 && foxTexture < 0.004; ++i) {
+    await nextFrame(page);
+    foxTexture = orangeShare(await canvasPixels(page));
+  }
+  await shot(page, '12-transfer-9-gltf-materials');
+  check(foxTexture > 0.004, `the Fox's texture covers ${(foxTexture * 100).toFixed(2)}% of the pair view`);
+  await page.uncheck('#tr-materials');
+  check(Object.values(await page.evaluate(() => window.__meshmorph.hooks.transferMaterials())).every((m) => m === 'analysis'), 'the toggle does not give the plain colours');
+  await page.check('#tr-materials');
+
   // Back to the Mesh job: its mesh is shown again.
   await page.click('#jobs button[data-job="mesh"]');
   await nextFrame(page);

@@ -11,6 +11,7 @@
 // own coordinates, where its markers live as children of its mesh).
 import * as THREE from 'three';
 import { applyArrays } from '../lib/arrays.js';
+import { disposeDocumentMaterials } from './document-materials.js';
 import { VertexPicker, ndcFromClient } from './picking.js';
 
 export const sides = ['reference', 'source'];
@@ -26,7 +27,7 @@ function createSide(name) {
   const mesh = new THREE.Mesh(new THREE.BufferGeometry(), material);
   mesh.name = `pair-${name}`;
   mesh.visible = false;
-  return { name, mesh, picker: new VertexPicker(), toWelded: null, loaded: false };
+  return { name, mesh, analysis: material, document: null, picker: new VertexPicker(), toWelded: null, loaded: false };
 }
 
 export class PairView {
@@ -40,6 +41,39 @@ export class PairView {
     this.raycaster = new THREE.Raycaster();
     this.mode = 'side';
     this.linked = true;
+    this.materialMode = 'document'; // a glTF side shows its own materials (not in overlay)
+  }
+
+  // A side's glTF materials (view/document-materials.js result for its current geometry).
+  setDocumentMaterials(name, display) {
+    const side = this.sides[name];
+    disposeDocumentMaterials(side.document);
+    side.document = display;
+    const geometry = side.mesh.geometry;
+    if (display.uv) geometry.setAttribute('uv', new THREE.BufferAttribute(display.uv, 2));
+    if (display.uv1) geometry.setAttribute('uv1', new THREE.BufferAttribute(display.uv1, 2));
+    geometry.clearGroups();
+    for (const g of display.groups) geometry.addGroup(g.start, g.count, g.materialIndex);
+    this.applyMaterials();
+  }
+
+  setMaterialMode(mode) {
+    this.materialMode = mode;
+    this.applyMaterials();
+  }
+
+  // Overlay needs the see-through analysis material; otherwise the toggle decides.
+  applyMaterials() {
+    for (const side of Object.values(this.sides)) {
+      const useDocument = side.document && this.materialMode === 'document' && this.mode !== 'overlay';
+      side.mesh.material = useDocument ? side.document.materials : side.analysis;
+    }
+    this.viewer.requestRender();
+  }
+
+  // What each side is drawn with: {reference, source} → 'document' | 'analysis'.
+  shownMaterials() {
+    return Object.fromEntries(Object.values(this.sides).map((s) => [s.name, s.mesh.material === s.analysis ? 'analysis' : 'document']));
   }
 
   get active() { return this.group.visible; }
@@ -60,11 +94,12 @@ export class PairView {
     const changed = mode !== this.mode;
     this.mode = mode;
     this.linked = linked;
-    const source = this.sides.source.mesh.material;
+    const source = this.sides.source.analysis;
     source.transparent = mode === 'overlay';
     source.opacity = mode === 'overlay' ? 0.5 : 1;
     source.depthWrite = mode !== 'overlay';
     source.needsUpdate = true;
+    this.applyMaterials();
     this.layout();
     this.applySplit();
     if (changed) this.frame();
@@ -101,8 +136,12 @@ export class PairView {
     if (!normals) geometry.computeVertexNormals();
     side.mesh.geometry.dispose();
     side.mesh.geometry = geometry;
-    side.mesh.material.side = open ? THREE.DoubleSide : THREE.FrontSide;
-    side.mesh.material.needsUpdate = true;
+    disposeDocumentMaterials(side.document);
+    side.document = null;
+    side.mesh.material = side.analysis;
+    side.analysis.side = open ? THREE.DoubleSide : THREE.FrontSide;
+    side.analysis.needsUpdate = true;
+    side.mesh.userData.pickSide = side.analysis.side;
     side.mesh.visible = true;
     side.toWelded = toWelded;
     side.loaded = true;

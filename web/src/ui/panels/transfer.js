@@ -21,6 +21,7 @@ import { unweldValues } from '../../lib/arrays.js';
 import { LandmarkPairs, landmarkFile, minLandmarks, readLandmarkFile } from '../../lib/landmarks.js';
 import { samples } from '../../lib/samples.js';
 import { weldedTriangles } from '../../lib/vertex-sets.js';
+import { documentMaterials, disposeDocumentMaterials, isGltfName } from '../../view/document-materials.js';
 import { LandmarkMarkers, labelTolerance, pairColor } from '../../view/landmark-markers.js';
 import { VertexMarker } from '../../view/marker.js';
 import { PairView } from '../../view/pair-view.js';
@@ -61,6 +62,9 @@ const markup = `
     <label title="Both meshes in one view, one camera"><input type="radio" name="tr-view" value="side" checked /> Side by side</label>
     <label title="Two views, each with its own camera"><input type="radio" name="tr-view" value="split" /> Split</label>
     <label title="Both meshes at the same place, the source see-through"><input type="radio" name="tr-view" value="overlay" /> Overlay</label>
+  </div>
+  <div class="row">
+    <label title="glTF meshes: their own materials and textures (not in Overlay); off: the plain colours"><input type="checkbox" id="tr-materials" checked /> Materials</label>
   </div>
   <div class="row" id="tr-link-row" hidden>
     <label title="Orbiting one view moves the other the same way"><input type="checkbox" id="tr-link" checked /> Link the cameras</label>
@@ -238,6 +242,7 @@ export const panel = {
       const [main] = files;
       const buffers = {};
       for (const f of files) buffers[f.name] = f.bytes;
+      const copies = isGltfName(main.name) ? files.map((f) => ({ name: f.name, bytes: f.bytes.slice() })) : null;
       transfer.loading = side;
       const loaded = await app.runOp(`Loading ${main.name} (${side})`, 'load', { name: main.name, slot: slots[side] }, buffers, { restoreKey: `mesh:${slots[side]}` });
       transfer.loading = null;
@@ -250,6 +255,14 @@ export const panel = {
       transfer[side] = { name: info.name, rawVertices: info.rawVertices, weldedVertices: info.weldedVertices };
       app.setStatus(`${side}: ${info.name}, ${info.weldedVertices} vertices, ${info.report.faces} faces · cancel: ${client.cancelMode}`);
       pair.setMesh(side, b, { open: info.report.boundaryLoopLengths.length > 0 || info.report.components === 0 });
+      if (copies) {
+        const entry = meshes[side];
+        documentMaterials(copies, info.primitives, info.rawVertices).then((display) => {
+          if (meshes[side] !== entry || display.error) return disposeDocumentMaterials(display);
+          pair.setDocumentMaterials(side, display);
+          return undefined;
+        });
+      }
       // A new mesh: pairs, suggestions and results of the old one mean nothing on it.
       landmarks.clear();
       setSuggestions([]);
@@ -426,6 +439,7 @@ export const panel = {
     }
     for (const radio of root.querySelectorAll('input[name="tr-view"]')) radio.addEventListener('change', () => setView(radio.value));
     $('tr-link').addEventListener('change', () => setView(transfer.view));
+    $('tr-materials').addEventListener('change', () => pair.setMaterialMode($('tr-materials').checked ? 'document' : 'analysis'));
 
     // Names on the panes (split) or the halves (side by side).
     const paneLabels = fromHtml('<div class="pane-labels" hidden><span>Reference</span><span>Source</span></div>');
@@ -580,6 +594,7 @@ export const panel = {
     app.hooks.transferVertexOnScreen = (side, vertex, tolerance = undefined) => vertexOnScreen(viewer, vertex, { ...pair.sides[side], ...pair.view(side), tolerance });
     app.hooks.labelTolerance = labelTolerance;
     app.hooks.transferLabels = () => markers.labels();
+    app.hooks.transferMaterials = () => pair.shownMaterials();
     app.hooks.transferCameras = () => [0, 1].map((i) => ({
       position: viewer.paneCamera(i).position.toArray(), target: (i ? viewer.controls2 : viewer.controls).target.toArray(),
     }));
