@@ -852,9 +852,9 @@ it('transfer: the cat pair side by side, run and compare; landmark pairs clicked
   let dropped = await page.evaluate(() => ({ loads: window.__meshmorph.state.loads, name: window.__meshmorph.state.mesh.name, error: window.__meshmorph.state.error, reference: window.__meshmorph.state.transfer.reference?.name }));
   check(dropped.loads === meshBefore.loads && dropped.name === meshBefore.name, `the drop during the Transfer load opened ${dropped.name} in the Mesh job`);
   check(dropped.error?.code === 'Busy' && dropped.reference === 'cat-07.ply', `drop while loading: ${JSON.stringify(dropped)}`);
+  check(/still loading/.test(await page.textContent('#toast')) && await page.isVisible('#toast'), 'the refused drop is not explained on the view');
   await shot(page, '12-transfer-0-drop-refused');
   // Dropped when idle on the right half, it opens as the source (still not in the Mesh job).
-  if (await page.isVisible('#error')) await page.click('#error-close');
   await page.evaluate(({ b64 }) => window.__dropFile(b64, 'hand_lowres.ply', 0.75), { b64: fs.readFileSync(handFile).toString('base64') });
   await page.waitForFunction(() => window.__meshmorph.state.transfer.source || window.__meshmorph.state.error, null, { timeout: 30000 });
   await waitIdle(page);

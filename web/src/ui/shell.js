@@ -13,6 +13,7 @@
 //                 view go to the job that is shown (never to another one); while an op runs a
 //                 drop is refused with a message
 //   app.notice(text) a message that is not an error (e.g. the worker was replaced)
+//   app.refuse({code, message}) an action not done (a toast for a few seconds)
 // Controls marked `data-idle` in a panel's markup are disabled while an op runs or the
 // worker is not ready.
 import { toMeshMorphError } from '../lib/errors.js';
@@ -85,7 +86,7 @@ export class Shell {
       if (!files?.length) return;
       const target = this.dropTargets.get(this.job);
       if (this.state.busy) {
-        this.showError({ code: 'Busy', message: `“${this.state.busy.label}” is still running: the dropped file was not opened. Drop it again when it has finished.` });
+        this.refuse({ code: 'Busy', message: `“${this.state.busy.label}” is still running: the dropped file was not opened. Drop it again when it has finished.` });
         return;
       }
       if (!target) {
@@ -108,6 +109,20 @@ export class Shell {
     if (this.state.error) this.errors.show({ code: this.state.error.code, message: `${this.state.error.message}\n${text}` });
     this.notice(text);
     this.emit('restarted', { code, restored });
+  }
+
+  // An action the page did not do (e.g. a drop while something loads): a toast on the view
+  // for a few seconds (the error banner would be cleared by the op that is running), recorded
+  // as state.error like an error.
+  refuse({ code, message }) {
+    this.state.error = { code, message };
+    this.toast ??= Object.assign(document.createElement('div'), { id: 'toast', role: 'status' });
+    if (!this.toast.isConnected) byId('viewport').append(this.toast);
+    this.toast.textContent = message;
+    this.toast.hidden = false;
+    clearTimeout(this.toastTimer);
+    this.toastTimer = setTimeout(() => { this.toast.hidden = true; }, 6000);
+    console.info(`[meshmorph] ${code}: ${message}`);
   }
 
   notice(text) {

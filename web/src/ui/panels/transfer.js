@@ -461,7 +461,7 @@ export const panel = {
       async drop(fileList, x) {
         const side = dropSide(x);
         if (transfer.loading) {
-          app.showError({ code: 'Busy', message: `the ${transfer.loading} is still loading: the dropped file was not opened. Drop it again when it has loaded.` });
+          app.refuse({ code: 'Busy', message: `The ${transfer.loading} is still loading: the dropped file was not opened. Drop it again when it has loaded.` });
           return;
         }
         try {
