@@ -6,7 +6,7 @@
 //   'side'    side by side in one pane, one camera; a pick tries both and keeps the nearer hit
 //   'split'   two panes (Viewer.setSplit), the reference left and the source right, each centred
 //             with its own camera; the cameras are linked (orbiting one moves both) or not
-//   'overlay' both at the same place in one pane, the source see-through
+//   'overlay' both at the same place in one pane, both see-through
 // Points given to and returned by this module are world space unless named `local` (a side's
 // own coordinates, where its markers live as children of its mesh).
 import * as THREE from 'three';
@@ -94,11 +94,15 @@ export class PairView {
     const changed = mode !== this.mode;
     this.mode = mode;
     this.linked = linked;
-    const source = this.sides.source.analysis;
-    source.transparent = mode === 'overlay';
-    source.opacity = mode === 'overlay' ? 0.5 : 1;
-    source.depthWrite = mode !== 'overlay';
-    source.needsUpdate = true;
+    // Overlay: both see-through (either can be inside the other), the source drawn last.
+    for (const side of Object.values(this.sides)) {
+      const material = side.analysis;
+      material.transparent = mode === 'overlay';
+      material.opacity = mode === 'overlay' ? (side.name === 'source' ? 0.55 : 0.4) : 1;
+      material.depthWrite = mode !== 'overlay';
+      material.needsUpdate = true;
+      side.mesh.renderOrder = mode === 'overlay' && side.name === 'source' ? 1 : 0;
+    }
     this.applyMaterials();
     this.layout();
     this.applySplit();

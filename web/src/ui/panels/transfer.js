@@ -61,7 +61,7 @@ const markup = `
     <span class="hint">View</span>
     <label title="Both meshes in one view, one camera"><input type="radio" name="tr-view" value="side" checked /> Side by side</label>
     <label title="Two views, each with its own camera"><input type="radio" name="tr-view" value="split" /> Split</label>
-    <label title="Both meshes at the same place, the source see-through"><input type="radio" name="tr-view" value="overlay" /> Overlay</label>
+    <label title="Both meshes at the same place, see-through"><input type="radio" name="tr-view" value="overlay" /> Overlay</label>
   </div>
   <div class="row">
     <label title="glTF meshes: their own materials and textures (not in Overlay); off: the plain colours"><input type="checkbox" id="tr-materials" checked /> Materials</label>
