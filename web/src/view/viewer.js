@@ -83,10 +83,9 @@ export class Viewer {
     const route = (e) => {
       if (!this.split) return;
       const right = e.clientX >= this.paneRect(1).left;
-      this.controls.enabled = this.controlsAllowed && !right;
-      this.controls2.enabled = this.controlsAllowed && right;
+      this.controls.enabled = !right;
+      this.controls2.enabled = right;
     };
-    this.controlsAllowed = true;
     canvas.parentElement.addEventListener('pointerdown', route, true);
     canvas.parentElement.addEventListener('wheel', route, { capture: true, passive: true });
 
@@ -152,18 +151,11 @@ export class Viewer {
       this.controls2.target.copy(this.controls.target);
       this.controls2.update();
     } else {
-      this.controls.enabled = this.controlsAllowed;
+      this.controls.enabled = true;
       this.controls2.enabled = false;
     }
     this.updateAspects();
     this.requestRender();
-  }
-
-  // Enables or disables orbiting (a brush or a gizmo owns the pointer meanwhile).
-  setControlsEnabled(on) {
-    this.controlsAllowed = on;
-    this.controls.enabled = on;
-    if (this.split) this.controls2.enabled = false;
   }
 
   // A camera moved (its orbit controls): linked panes follow it.
