@@ -142,3 +142,40 @@ test('a wasm trap replaces the worker and restores the mesh', async () => {
     client.dropWorker();
   }
 });
+
+test('running out of wasm memory replaces the worker and restores the mesh (onRestart tells)', async () => {
+  const restarts = [];
+  const { client, started } = makeClient({ onRestart: (detail) => restarts.push(detail) });
+  try {
+    await client.ready;
+    await loadArmadillo(client);
+    const { info } = await client.run('debugExhaustMemory').promise;
+    assert.ok(info.allocatedMB > 2000, `the heap grew to ${info.allocatedMB} MB only`);
+    await assert.rejects(client.run('eigs', { k: 10 }).promise, (e) => e.code === 'OutOfMemory' && /out of memory/.test(e.message));
+    await client.ready;
+    assert.equal(client.restarts, 1);
+    assert.equal(started(), 2);
+    assert.deepEqual(restarts.map((r) => [r.code, r.restored]), [['OutOfMemory', ['mesh:main']]]);
+    const { info: report } = await client.run('validate', {}).promise;
+    assert.equal(report.report.vertices, 14587, 'the new worker has the armadillo again');
+  } finally {
+    client.dropWorker();
+  }
+});
+
+test('a worker that dies (uncaught error) is replaced and the mesh restored', async () => {
+  const restarts = [];
+  const { client } = makeClient({ onRestart: (detail) => restarts.push(detail) });
+  try {
+    await client.ready;
+    await loadArmadillo(client);
+    await client.run('debugCrash').promise;
+    for (let i = 0; i < 100 && !restarts.length; ++i) await new Promise((resolve) => setTimeout(resolve, 50));
+    assert.equal(restarts.length, 1, 'no restart after the worker died');
+    assert.equal(restarts[0].code, 'Crashed');
+    const { info } = await client.run('validate', {}).promise;
+    assert.equal(info.report.vertices, 14587);
+  } finally {
+    client.dropWorker();
+  }
+});

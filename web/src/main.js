@@ -17,7 +17,8 @@ const viewer = new Viewer(byId('view'));
 const client = new MeshMorphClient({
   createWorker: () => new Worker(new URL('./worker/worker.js', import.meta.url), { type: 'module' }),
   cancelMode: params.get('cancel') === 'terminate' ? 'terminate' : 'auto',
-  onStatus: (text) => console.warn(`[meshmorph] ${text}`),
+  onStatus: (text) => shell.notice(text), // eslint-disable-line no-use-before-define
+  onRestart: (detail) => shell.workerRestarted(detail), // eslint-disable-line no-use-before-define
 });
 const shell = new Shell({ client, viewer, params });
 for (const panel of panels) shell.register(panel);

@@ -61,3 +61,36 @@ export function unweldValues(values, toWelded, itemSize, out = new Float32Array(
   }
   return out;
 }
+
+// Area-weighted vertex normals (unit length; #V·3 Float32Array) of a triangle mesh: positions
+// #V·3, indices #F·3. The worker computes them for previews (ops/edit.js), so the main thread
+// only copies arrays while a gizmo is dragged.
+export function vertexNormals(positions, indices, count = positions.length / 3) {
+  const n = new Float32Array(count * 3);
+  for (let t = 0; t < indices.length; t += 3) {
+    const a = 3 * indices[t];
+    const b = 3 * indices[t + 1];
+    const c = 3 * indices[t + 2];
+    const ux = positions[b] - positions[a];
+    const uy = positions[b + 1] - positions[a + 1];
+    const uz = positions[b + 2] - positions[a + 2];
+    const vx = positions[c] - positions[a];
+    const vy = positions[c + 1] - positions[a + 1];
+    const vz = positions[c + 2] - positions[a + 2];
+    const x = uy * vz - uz * vy;
+    const y = uz * vx - ux * vz;
+    const z = ux * vy - uy * vx;
+    for (const i of [a, b, c]) {
+      n[i] += x;
+      n[i + 1] += y;
+      n[i + 2] += z;
+    }
+  }
+  for (let i = 0; i < n.length; i += 3) {
+    const length = Math.sqrt(n[i] * n[i] + n[i + 1] * n[i + 1] + n[i + 2] * n[i + 2]) || 1;
+    n[i] /= length;
+    n[i + 1] /= length;
+    n[i + 2] /= length;
+  }
+  return n;
+}

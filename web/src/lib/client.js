@@ -10,8 +10,12 @@
 //     worker is terminated and a new one started. Its state is rebuilt by replaying the
 //     requests that were marked `restoreKey` (e.g. the current mesh's load), from copies kept
 //     here, before any new request runs.
-// The same replacement happens when the worker fails to initialise (up to `maxInitAttempts`)
-// or reports a fatal error (a wasm trap).
+// The same replacement happens when the worker fails to initialise (up to `maxInitAttempts`),
+// reports a fatal error (a wasm trap), dies (an uncaught error: its 'error' event), or runs out
+// of wasm memory (code OutOfMemory: the 4 GB heap never shrinks, so that worker would fail
+// again and again): the request fails with that code, the other pending ones with Aborted, and
+// `onRestart({why, code})` is called when the new worker has replayed the restore requests
+// (`restored`: their keys) — the page says so and panels drop state the old worker held.
 import { MeshMorphError, toMeshMorphError } from './errors.js';
 import { cloneBuffers, transferList } from './protocol.js';
 
@@ -19,8 +23,9 @@ export class MeshMorphClient {
   // createWorker: () => Worker-like {postMessage, terminate, onmessage, onerror}.
   // cancelMode: 'auto' (cooperative when crossOriginIsolated), 'cooperative' or 'terminate'.
   // onStatus: (text) => void, for diagnostics (worker restarts).
-  constructor({ createWorker, maxInitAttempts = 3, cancelGraceMs = 2000, cancelMode = 'auto', onStatus = () => {} }) {
+  constructor({ createWorker, maxInitAttempts = 3, cancelGraceMs = 2000, cancelMode = 'auto', onStatus = () => {}, onRestart = () => {} }) {
     this.createWorker = createWorker;
+    this.onRestart = onRestart;
     this.maxInitAttempts = maxInitAttempts;
     this.cancelGraceMs = cancelGraceMs;
     this.onStatus = onStatus;
@@ -148,7 +153,7 @@ export class MeshMorphClient {
         entry.resolve({ buffers: message.buffers, info: message.info });
         break;
       case 'error':
-        if (message.fatal) {
+        if (message.fatal || message.code === 'OutOfMemory') {
           this.crashed(worker, message.message, message.id, message.code);
           return;
         }
@@ -209,8 +214,14 @@ export class MeshMorphClient {
       entry.reject(new MeshMorphError(id === failedId || failedId === null ? code : 'Aborted', text));
     }
     this.restarts += 1;
-    this.onStatus(`worker crashed (${text}); starting a new one`);
+    this.onStatus(`the geometry worker failed (${code}); starting a new one`);
     this.ready = this.spawn();
+    this.ready.then(() => this.onRestart({ why: text, code, restored: [...this.restore.keys()] }), () => {});
+  }
+
+  // Stops replaying a restore request (e.g. the mesh it loaded was unloaded).
+  forget(restoreKey) {
+    this.restore.delete(restoreKey);
   }
 
   dropWorker() {

@@ -1,72 +1,89 @@
-// An options form generated from a job's options schema (the optionSchema op's options: [{name, kind,
-// default, min, max, choices, help}], kinds integer, number, boolean, choice, text): one control
-// per option with its help as a line under it and as a tooltip, inside a collapsible
-// <details>. values() gives only the options the user changed from their defaults, under the
-// schema's names — what a spec's "options" object or an op's options take.
-import { fromHtml } from './dom.js';
+// A job's options panel, generated from its options schema (the optionSchema op, the same JSON
+// as `meshmorph options <job> --json`: [{name, kind, default, min, max, choices, help}], kinds
+// integer, number, boolean, choice, text) with lil-gui: one controller per option, starting at
+// the schema's default (the paper's value), its one-line help under it and as a tooltip, in a
+// collapsible lil-gui panel (closed at first). values() gives only the options the user changed
+// from their defaults, under the schema's names — what a spec's "options" object or an op's
+// options take. Each option's input carries id `opt-<name>` and data-option (tests, labels).
+import GUI from 'lil-gui';
 
-function control(option) {
-  const { kind, name } = option;
-  if (kind === 'boolean') {
-    const input = fromHtml(`<input type="checkbox" />`);
-    input.checked = Boolean(option.default);
-    return { input, read: () => input.checked, write: (v) => { input.checked = Boolean(v); } };
-  }
-  if (kind === 'choice') {
-    const input = document.createElement('select');
-    for (const c of option.choices || []) input.add(new Option(c, c));
-    input.value = option.default;
-    return { input, read: () => input.value, write: (v) => { input.value = String(v); } };
-  }
-  const input = document.createElement('input');
-  input.name = name;
-  if (kind === 'integer' || kind === 'number') {
-    input.type = 'number';
-    input.step = kind === 'integer' ? '1' : 'any';
-    if (Number.isFinite(option.min)) input.min = String(option.min);
-    if (Number.isFinite(option.max)) input.max = String(option.max);
-    input.value = String(option.default);
-    return { input, read: () => Number(input.value), write: (v) => { input.value = String(v); } };
-  }
-  input.type = 'text';
-  input.value = option.default ?? '';
-  return { input, read: () => input.value, write: (v) => { input.value = String(v); } };
+// A short range text for the help line: "1 … 3", "≥ 1e-12".
+function range(option) {
+  const lo = Number.isFinite(option.min);
+  const hi = Number.isFinite(option.max);
+  if (lo && hi) return ` (${option.min} … ${option.max})`;
+  if (lo) return ` (≥ ${option.min})`;
+  if (hi) return ` (≤ ${option.max})`;
+  return '';
 }
 
-function range(option) {
-  const parts = [];
-  if (Number.isFinite(option.min)) parts.push(`≥ ${option.min}`);
-  if (Number.isFinite(option.max)) parts.push(`≤ ${option.max}`);
-  return parts.length ? ` (${parts.join(', ')})` : '';
+// A slider only where dragging makes sense: a bounded range of at most `sliderSpan` steps
+// (integers) or a bounded real range that is not astronomically wide.
+const sliderSpan = 64;
+function wantsSlider(option) {
+  if (!Number.isFinite(option.min) || !Number.isFinite(option.max)) return false;
+  const span = option.max - option.min;
+  return option.kind === 'integer' ? span <= sliderSpan : span > 0 && span <= 1000 && option.min >= 0;
 }
 
 export class OptionsForm {
-  // schema: the optionSchema array; title: the <summary> text.
+  // schema: the optionSchema array; title: the panel's title.
   constructor(schema, { title = 'Options' } = {}) {
     this.schema = schema;
-    this.element = fromHtml(`<details class="options"><summary></summary><div class="options-list"></div></details>`);
-    this.element.querySelector('summary').textContent = title;
-    const list = this.element.querySelector('.options-list');
+    this.values_ = Object.fromEntries(schema.map((o) => [o.name, o.default ?? (o.kind === 'text' ? '' : 0)]));
+    this.gui = new GUI({ autoPlace: false, title, closeFolders: true, width: undefined });
+    this.gui.domElement.classList.add('options');
+    this.element = this.gui.domElement;
     this.controls = new Map();
     for (const option of schema) {
-      const c = control(option);
-      c.input.id = `opt-${option.name}`;
-      c.input.dataset.option = option.name;
-      const row = fromHtml(`<div class="option"><label></label><p class="hint"></p></div>`);
-      const label = row.querySelector('label');
-      label.append(`${option.name} `, c.input);
-      label.title = `${option.help}${range(option)} · default ${option.default}`;
-      row.querySelector('.hint').textContent = `${option.help}${range(option)}`;
-      list.append(row);
-      this.controls.set(option.name, { ...c, option });
+      const controller = this.addController(option);
+      const input = controller.$input || controller.$select;
+      if (input) {
+        input.id = `opt-${option.name}`;
+        input.dataset.option = option.name;
+      }
+      controller.domElement.classList.add('option');
+      controller.domElement.title = `${option.help}${range(option)} · default ${option.default}`;
+      const hint = document.createElement('div');
+      hint.className = 'option-help';
+      hint.textContent = `${option.help}${range(option)}`;
+      controller.domElement.after(hint);
+      this.controls.set(option.name, { controller, option, hint });
     }
+    this.gui.close();
+  }
+
+  addController(option) {
+    const { name, kind } = option;
+    const object = this.values_;
+    if (kind === 'choice') return this.gui.add(object, name, option.choices || []);
+    if (kind === 'boolean') {
+      object[name] = Boolean(object[name]);
+      return this.gui.add(object, name);
+    }
+    if (kind === 'integer' || kind === 'number') {
+      object[name] = Number(object[name]);
+      const slider = wantsSlider(option);
+      const c = this.gui.add(object, name);
+      if (Number.isFinite(option.min)) c.min(option.min);
+      // Without a slider the maximum is enforced here (lil-gui draws a slider as soon as both
+      // bounds are set).
+      if (slider) c.max(option.max);
+      else if (Number.isFinite(option.max)) {
+        c.onChange((v) => { if (v > option.max) c.setValue(option.max); });
+      }
+      if (kind === 'integer') c.step(1);
+      return c;
+    }
+    object[name] = String(object[name] ?? '');
+    return this.gui.add(object, name);
   }
 
   // {name: value} of the options that differ from their defaults.
   values() {
     const out = {};
-    for (const [name, { read, option }] of this.controls) {
-      const value = read();
+    for (const [name, { option }] of this.controls) {
+      const value = this.values_[name];
       if (value !== option.default) out[name] = value;
     }
     return out;
@@ -75,6 +92,15 @@ export class OptionsForm {
   // Sets the given options (others go back to their defaults); unknown names are ignored here
   // (the core rejects them with a message when the spec is used).
   setValues(values = {}) {
-    for (const [name, { write, option }] of this.controls) write(name in values ? values[name] : option.default);
+    for (const [name, { controller, option }] of this.controls) {
+      controller.setValue(name in values ? values[name] : option.default);
+    }
   }
+
+  // Enables or disables every control (while an op runs).
+  setEnabled(on) {
+    for (const { controller } of this.controls.values()) controller.enable(on);
+  }
+
+  open(on = true) { this.gui.open(on); }
 }

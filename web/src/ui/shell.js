@@ -9,10 +9,15 @@
 //                 is up), 'mesh' (a mesh was loaded; detail = app.state.mesh), 'job' (switched)
 //   app.showError(e), app.clearError(), app.setStatus(text)
 //   app.hooks     functions for the end-to-end tests (window.__meshmorph.hooks)
+//   app.onDrop(job, {describe(clientX) → text, drop(fileList, clientX)})  files dropped on the
+//                 view go to the job that is shown (never to another one); while an op runs a
+//                 drop is refused with a message
+//   app.notice(text) a message that is not an error (e.g. the worker was replaced)
+//   app.refuse({code, message}) an action not done (a toast for a few seconds)
 // Controls marked `data-idle` in a panel's markup are disabled while an op runs or the
 // worker is not ready.
 import { toMeshMorphError } from '../lib/errors.js';
-import { byId } from './dom.js';
+import { byId, fromHtml } from './dom.js';
 import { ErrorBanner } from './error-banner.js';
 import { ProgressView } from './progress.js';
 import { JobSwitcher } from './switcher.js';
@@ -37,6 +42,92 @@ export class Shell {
     });
     this.errors = new ErrorBanner();
     this.switcher = new JobSwitcher(byId('jobs'), (job) => this.showJob(job));
+    this.dropTargets = new Map();
+    this.setupDrop();
+  }
+
+  get job() { return this.switcher.selected; }
+
+  onDrop(job, target) {
+    this.dropTargets.set(job, target);
+  }
+
+  // Drag and drop on the view: the overlay says where the files will go (the shown job's
+  // target), a drop goes there, and only there.
+  setupDrop() {
+    const viewport = byId('viewport');
+    const overlay = fromHtml('<div id="drop-overlay" hidden></div>');
+    byId('view').after(overlay);
+    let depth = 0;
+    const describe = (x) => {
+      if (this.state.busy) return `Busy: ${this.state.busy.label}… drop again when it has finished`;
+      const target = this.dropTargets.get(this.job);
+      return target ? target.describe(x) : 'This job does not open files';
+    };
+    viewport.addEventListener('dragenter', (e) => {
+      e.preventDefault();
+      depth += 1;
+      overlay.textContent = describe(e.clientX);
+      overlay.hidden = false;
+    });
+    viewport.addEventListener('dragleave', () => {
+      depth = Math.max(0, depth - 1);
+      if (!depth) overlay.hidden = true;
+    });
+    viewport.addEventListener('dragover', (e) => {
+      e.preventDefault();
+      overlay.textContent = describe(e.clientX);
+    });
+    viewport.addEventListener('drop', (e) => {
+      e.preventDefault();
+      depth = 0;
+      overlay.hidden = true;
+      const files = e.dataTransfer?.files;
+      if (!files?.length) return;
+      const target = this.dropTargets.get(this.job);
+      if (this.state.busy) {
+        this.refuse({ code: 'Busy', message: `“${this.state.busy.label}” is still running: the dropped file was not opened. Drop it again when it has finished.` });
+        return;
+      }
+      if (!target) {
+        this.showError({ code: 'Unsupported', message: `the ${this.jobTitle(this.job)} job does not open dropped files` });
+        return;
+      }
+      target.drop(files, e.clientX);
+    });
+  }
+
+  // The client replaced a worker that failed (crash, out of memory): the new one has loaded
+  // the meshes again. The error of the request that failed is already shown; this adds what
+  // happened next, and tells the panels ('restarted').
+  workerRestarted({ code, restored }) {
+    this.state.recoveries = (this.state.recoveries || 0) + 1;
+    const meshes = restored.filter((k) => k.startsWith('mesh:')).length;
+    const text = `The geometry worker ${code === 'OutOfMemory' ? 'ran out of memory' : 'stopped'}; a new one was started`
+      + `${meshes ? ` and ${meshes === 1 ? 'the loaded mesh was' : `the ${meshes} loaded meshes were`} restored` : ''}.`;
+    this.state.recovery = { code, restored, text };
+    if (this.state.error) this.errors.show({ code: this.state.error.code, message: `${this.state.error.message}\n${text}` });
+    this.notice(text);
+    this.emit('restarted', { code, restored });
+  }
+
+  // An action the page did not do (e.g. a drop while something loads): a toast on the view
+  // for a few seconds (the error banner would be cleared by the op that is running), recorded
+  // as state.error like an error.
+  refuse({ code, message }) {
+    this.state.error = { code, message };
+    this.toast ??= Object.assign(document.createElement('div'), { id: 'toast', role: 'status' });
+    if (!this.toast.isConnected) byId('viewport').append(this.toast);
+    this.toast.textContent = message;
+    this.toast.hidden = false;
+    clearTimeout(this.toastTimer);
+    this.toastTimer = setTimeout(() => { this.toast.hidden = true; }, 6000);
+    console.info(`[meshmorph] ${code}: ${message}`);
+  }
+
+  notice(text) {
+    this.setStatus(text);
+    console.info(`[meshmorph] ${text}`);
   }
 
   // panel: {id, title, job?, create(app) → Element}. `job` is the switcher entry the panel
@@ -79,7 +170,9 @@ export class Shell {
     const error = toMeshMorphError(e, 'Error');
     this.state.error = { code: error.code, message: error.message };
     this.errors.show(error);
-    console.error(`[meshmorph] ${error.code}: ${error.message}`);
+    // Shown to the user and handled: information in the console, not an error (the e2e runs
+    // require a console free of warnings and errors).
+    console.info(`[meshmorph] ${error.code}: ${error.message}`);
   }
 
   clearError() {

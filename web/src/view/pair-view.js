@@ -2,14 +2,20 @@
 // the source — or the transfer result — on the right). Each side is a THREE.Mesh with its own
 // VertexPicker (view/picking.js); both are scaled to the same display size (their bounding
 // radius → 1) and placed next to each other, so meshes in different units are comparable.
-// One camera and the viewer's orbit controls look at both; a pick tries both sides and keeps
-// the nearer hit. Points given to and returned by this module are world space unless named
-// `local` (a side's own coordinates, where its markers live as children of its mesh).
+// Three ways to show them (setMode):
+//   'side'    side by side in one pane, one camera; a pick tries both and keeps the nearer hit
+//   'split'   two panes (Viewer.setSplit), the reference left and the source right, each centred
+//             with its own camera; the cameras are linked (orbiting one moves both) or not
+//   'overlay' both at the same place in one pane, both see-through
+// Points given to and returned by this module are world space unless named `local` (a side's
+// own coordinates, where its markers live as children of its mesh).
 import * as THREE from 'three';
 import { applyArrays } from '../lib/arrays.js';
+import { disposeDocumentMaterials } from './document-materials.js';
 import { VertexPicker, ndcFromClient } from './picking.js';
 
 export const sides = ['reference', 'source'];
+export const modes = ['side', 'split', 'overlay'];
 const sideColors = { reference: 0xb9c7e0, source: 0xd8cdbf };
 const gap = 0.2; // between the two meshes' bounding spheres, in display radii
 
@@ -21,7 +27,7 @@ function createSide(name) {
   const mesh = new THREE.Mesh(new THREE.BufferGeometry(), material);
   mesh.name = `pair-${name}`;
   mesh.visible = false;
-  return { name, mesh, picker: new VertexPicker(), toWelded: null, loaded: false };
+  return { name, mesh, analysis: material, document: null, picker: new VertexPicker(), toWelded: null, loaded: false };
 }
 
 export class PairView {
@@ -33,6 +39,41 @@ export class PairView {
     this.sides = Object.fromEntries(sides.map((name) => [name, createSide(name)]));
     for (const side of Object.values(this.sides)) this.group.add(side.mesh);
     this.raycaster = new THREE.Raycaster();
+    this.mode = 'side';
+    this.linked = true;
+    this.materialMode = 'document'; // a glTF side shows its own materials (not in overlay)
+  }
+
+  // A side's glTF materials (view/document-materials.js result for its current geometry).
+  setDocumentMaterials(name, display) {
+    const side = this.sides[name];
+    disposeDocumentMaterials(side.document);
+    side.document = display;
+    const geometry = side.mesh.geometry;
+    if (display.uv) geometry.setAttribute('uv', new THREE.BufferAttribute(display.uv, 2));
+    if (display.uv1) geometry.setAttribute('uv1', new THREE.BufferAttribute(display.uv1, 2));
+    geometry.clearGroups();
+    for (const g of display.groups) geometry.addGroup(g.start, g.count, g.materialIndex);
+    this.applyMaterials();
+  }
+
+  setMaterialMode(mode) {
+    this.materialMode = mode;
+    this.applyMaterials();
+  }
+
+  // Overlay needs the see-through analysis material; otherwise the toggle decides.
+  applyMaterials() {
+    for (const side of Object.values(this.sides)) {
+      const useDocument = side.document && this.materialMode === 'document' && this.mode !== 'overlay';
+      side.mesh.material = useDocument ? side.document.materials : side.analysis;
+    }
+    this.viewer.requestRender();
+  }
+
+  // What each side is drawn with: {reference, source} → 'document' | 'analysis'.
+  shownMaterials() {
+    return Object.fromEntries(Object.values(this.sides).map((s) => [s.name, s.mesh.material === s.analysis ? 'analysis' : 'document']));
   }
 
   get active() { return this.group.visible; }
@@ -42,8 +83,52 @@ export class PairView {
     if (this.group.visible === on) return;
     this.group.visible = on;
     this.viewer.setMainVisible(!on);
+    this.applySplit();
     if (on) this.frame();
     this.viewer.requestRender();
+  }
+
+  // 'side' | 'split' | 'overlay' (see above); linked: the split panes' cameras move together.
+  setMode(mode, { linked = this.linked } = {}) {
+    if (!modes.includes(mode)) throw new Error(`unknown pair view mode ${mode}`);
+    const changed = mode !== this.mode;
+    this.mode = mode;
+    this.linked = linked;
+    // Overlay: both see-through (either can be inside the other), the source drawn last.
+    for (const side of Object.values(this.sides)) {
+      const material = side.analysis;
+      material.transparent = mode === 'overlay';
+      material.opacity = mode === 'overlay' ? (side.name === 'source' ? 0.55 : 0.4) : 1;
+      material.depthWrite = mode !== 'overlay';
+      material.needsUpdate = true;
+      side.mesh.renderOrder = mode === 'overlay' && side.name === 'source' ? 1 : 0;
+    }
+    this.applyMaterials();
+    this.layout();
+    this.applySplit();
+    if (changed) this.frame();
+    this.viewer.requestRender();
+  }
+
+  applySplit() {
+    const { viewer } = this;
+    const split = this.active && this.mode === 'split';
+    if (!split) {
+      if (viewer.split) viewer.setSplit(null);
+      return;
+    }
+    const meshes = sides.map((name) => this.sides[name]);
+    viewer.setSplit({
+      linked: this.linked,
+      beforePass: (i) => meshes.forEach((side, k) => { side.mesh.visible = side.loaded && k === i; }),
+      afterPasses: () => meshes.forEach((side) => { side.mesh.visible = side.loaded; }),
+    });
+  }
+
+  // Which pane shows a side (0 unless split) and its camera and client rectangle.
+  view(name) {
+    const pane = this.mode === 'split' && this.active && name === 'source' ? 1 : 0;
+    return { pane, camera: this.viewer.paneCamera(pane), rect: this.viewer.paneRect(pane) };
   }
 
   // A mesh for one side: positions/normals/indices (+ toWelded) from a load result; `open` as
@@ -55,8 +140,12 @@ export class PairView {
     if (!normals) geometry.computeVertexNormals();
     side.mesh.geometry.dispose();
     side.mesh.geometry = geometry;
-    side.mesh.material.side = open ? THREE.DoubleSide : THREE.FrontSide;
-    side.mesh.material.needsUpdate = true;
+    disposeDocumentMaterials(side.document);
+    side.document = null;
+    side.mesh.material = side.analysis;
+    side.analysis.side = open ? THREE.DoubleSide : THREE.FrontSide;
+    side.analysis.needsUpdate = true;
+    side.mesh.userData.pickSide = side.analysis.side;
     side.mesh.visible = true;
     side.toWelded = toWelded;
     side.loaded = true;
@@ -84,6 +173,7 @@ export class PairView {
   // Display size: both sides scaled to bounding radius 1 and centred on their bounding boxes,
   // the reference at x = -(1 + gap / 2), the source at x = +(1 + gap / 2): fixed places, so
   // switching the source for the result (another extent) does not move the other side.
+  // In split and overlay modes both are centred on the origin.
   layout() {
     for (const side of Object.values(this.sides)) {
       const geometry = side.mesh.geometry;
@@ -92,7 +182,7 @@ export class PairView {
       const center = geometry.boundingBox.getCenter(new THREE.Vector3());
       side.mesh.scale.setScalar(scale);
       side.mesh.position.copy(center).multiplyScalar(-scale);
-      side.mesh.position.x += (side.name === 'reference' ? -1 : 1) * (1 + gap / 2);
+      if (this.mode === 'side') side.mesh.position.x += (side.name === 'reference' ? -1 : 1) * (1 + gap / 2);
     }
     this.group.updateMatrixWorld(true);
   }
@@ -100,19 +190,28 @@ export class PairView {
   frame() {
     const meshes = Object.values(this.sides).filter((s) => s.loaded).map((s) => s.mesh);
     // Straight from the front (slightly above): both sides at the same distance, the same size.
-    if (meshes.length && this.active) this.viewer.frameMeshes(meshes, { direction: [0, 0.3, 1] });
+    // Split panes frame both meshes (they share the place), so linked cameras agree.
+    if (!meshes.length || !this.active) return;
+    this.viewer.frameMeshes(meshes, { direction: [0, 0.3, 1] });
+    if (this.mode === 'split') this.viewer.frameMeshes(meshes, { direction: [0, 0.3, 1], pane: 1 });
   }
 
   // The vertex under a pointer position on either side: the picking.js result plus `side`, or
   // null. Both sides are ray cast; the nearer hit wins.
   pickAt(clientX, clientY) {
     if (!this.active) return null;
-    const { camera, renderer } = this.viewer;
-    const [x, y] = ndcFromClient(clientX, clientY, renderer.domElement.getBoundingClientRect());
+    let candidates = Object.values(this.sides);
+    let pane = 0;
+    if (this.mode === 'split') {
+      pane = clientX >= this.viewer.paneRect(1).left ? 1 : 0;
+      candidates = [candidates[pane]];
+    }
+    const camera = this.viewer.paneCamera(pane);
+    const [x, y] = ndcFromClient(clientX, clientY, this.viewer.paneRect(pane));
     camera.updateMatrixWorld();
     this.raycaster.setFromCamera(new THREE.Vector2(x, y), camera);
     let best = null;
-    for (const side of Object.values(this.sides)) {
+    for (const side of candidates) {
       if (!side.loaded) continue;
       const pick = side.picker.pickRay(this.raycaster.ray);
       if (pick && (!best || pick.distance < best.distance)) best = { ...pick, side: side.name };

@@ -107,7 +107,9 @@ export class VertexPicker {
     const { mesh } = this;
     mesh.updateMatrixWorld();
     this.localRay.copy(ray).applyMatrix4(this.inverse.copy(mesh.matrixWorld).invert());
-    const hit = bvh.raycastFirst(this.localRay, mesh.material.side ?? THREE.FrontSide);
+    // (a mesh drawn with several materials names the side in userData.pickSide).
+    const side = mesh.userData.pickSide ?? (Array.isArray(mesh.material) ? mesh.material[0]?.side : mesh.material.side);
+    const hit = bvh.raycastFirst(this.localRay, side ?? THREE.FrontSide);
     if (!hit) return null;
     const positions = mesh.geometry.getAttribute('position').array;
     const vertex = nearestCorner(positions, [hit.face.a, hit.face.b, hit.face.c], hit.point.toArray());

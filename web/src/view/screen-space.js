@@ -35,10 +35,12 @@ export function projectVertices(viewer) {
 
 // True when the raw vertex is the first surface point the camera sees along its line of sight
 // (within a small tolerance of the scene's size).
-export function vertexVisible(viewer, vertex, { mesh = viewer.mesh, picker = viewer.picker } = {}) {
+// `tolerance`: how far (relative to the mesh's bounding radius) the first surface point may lie
+// in front of the vertex (landmark numbers use a few percent, so the tip of a paw seen from
+// above still counts as seen).
+export function vertexVisible(viewer, vertex, { mesh = viewer.mesh, picker = viewer.picker, camera = viewer.camera, tolerance: relative = 1e-3 } = {}) {
   const bvh = picker.ensureBvh();
   if (!bvh) return false;
-  const { camera } = viewer;
   const p = mesh.geometry.getAttribute('position').array;
   mesh.updateMatrixWorld();
   inverse.copy(mesh.matrixWorld).invert();
@@ -50,21 +52,22 @@ export function vertexVisible(viewer, vertex, { mesh = viewer.mesh, picker = vie
   if (!(distance > 0)) return false;
   ray.direction.divideScalar(distance);
   const hit = bvh.raycastFirst(ray, THREE.DoubleSide);
-  const tolerance = 1e-3 * (mesh.geometry.boundingSphere?.radius || 1);
+  const tolerance = relative * (mesh.geometry.boundingSphere?.radius || 1);
   return !hit || hit.distance >= distance - tolerance;
 }
 
 // Where a raw vertex is on the screen: {x, y} in client pixels, visible (in the view and not
-// hidden by the surface).
+// hidden by the surface). target: {mesh, picker, camera, rect} (default: the viewer's mesh,
+// picker, camera and canvas), e.g. a side of view/pair-view.js in its pane.
 export function vertexOnScreen(viewer, vertex, target = {}) {
-  const { camera } = viewer;
+  const camera = target.camera ?? viewer.camera;
   const mesh = target.mesh ?? viewer.mesh;
-  const rect = viewer.renderer.domElement.getBoundingClientRect();
+  const rect = target.rect ?? viewer.renderer.domElement.getBoundingClientRect();
   camera.updateMatrixWorld();
   const world = new THREE.Vector3().fromBufferAttribute(mesh.geometry.getAttribute('position'), vertex).applyMatrix4(mesh.matrixWorld);
   const ndc = world.clone().project(camera);
   const x = rect.left + ((ndc.x + 1) / 2) * rect.width;
   const y = rect.top + ((1 - ndc.y) / 2) * rect.height;
   const inView = Math.abs(ndc.x) < 1 && Math.abs(ndc.y) < 1 && Math.abs(ndc.z) < 1;
-  return { x, y, visible: inView && mesh.visible && vertexVisible(viewer, vertex, { mesh, picker: target.picker ?? viewer.picker }) };
+  return { x, y, visible: inView && mesh.visible && vertexVisible(viewer, vertex, { mesh, picker: target.picker ?? viewer.picker, camera, tolerance: target.tolerance }) };
 }

@@ -137,3 +137,11 @@ export type Op = (ctx: OpContext, options: object, buffers: Buffers) => { buffer
 // export   {slot?, format? = 'glb', recompute_normals?} + buffers {positions?}
 //          → {bytes} / {fileName, format, byteLength}
 // unload   {slot?} → {} / {slot, unloaded}
+
+// ---- transfer ops (ops/transfer.js), besides transfer and compare
+// suggestLandmarks {referenceSlot?, sourceSlot?, count? = 8, sameConnectivity?}
+//          → {} / {pairs: [[r, s, cost]] (welded), reference, source: {centre, radius,
+//            extremities: [{vertex, relative, direction}], between}}
+// ---- edit ops (ops/edit.js): positions results carry {positions, rawPositions, rawNormals}
+// ---- debug ops (ops/debug.js; the e2e recovery checks only)
+// debugExhaustMemory {} → {} / {allocatedMB};  debugCrash {} → the worker dies after answering

@@ -111,6 +111,7 @@ export const panel = {
     let centroids = [];      // per handle, in a session: the rest centroid (the gizmo's pivot)
     let welded = null;       // current welded positions (Float32Array #W·3) after a drag/finalize
     let shown = null;        // the same in the raw layout (what the Edit job shows)
+    let shownNormals = null; // its normals (raw layout), from the worker
     let form = null;         // OptionsForm, once the schema arrived
     let visible = false;     // the Edit job is shown
 
@@ -314,7 +315,8 @@ export const panel = {
     function show(result) {
       welded = result.buffers.positions;
       shown = result.buffers.rawPositions;
-      if (visible) viewer.setPositions(shown);
+      shownNormals = result.buffers.rawNormals;
+      if (visible) viewer.setPositions(shown, shownNormals);
     }
 
     const moves = new EditMoves({
@@ -469,13 +471,22 @@ export const panel = {
       refresh();
     });
     app.on('mesh', (mesh) => newMesh(mesh));
+    // A replaced worker has the meshes again but not the edit session: back to the selection
+    // (the painted sets stay).
+    app.on('restarted', () => {
+      if (!edit.session) return;
+      edit.session = false; // nothing to dispose in the new worker
+      endSession();
+      refresh();
+      updateBrush();
+    });
     app.on('job', (job) => {
       const was = visible;
       visible = job === 'edit';
       // Other jobs work on the loaded mesh, so they show it; the edit comes back with the job.
       if (visible) {
         showColors();
-        if (shown) viewer.setPositions(shown.slice());
+        if (shown) viewer.setPositions(shown.slice(), shownNormals?.slice());
         if (edit.session) gizmo.show();
       } else if (was) {
         viewer.setColors(null);

@@ -5,10 +5,13 @@
 //   loads    successful loads; exports: successful exports (tests wait on both)
 //   pick     the vertex under the pointer (view/picking.js), null when off the mesh
 //   pinned   the last clicked vertex, null until a click on the mesh
+//   materials {available, textured, count, reason, shown ('document' | 'analysis')} of the
+//            loaded mesh's own glTF materials (view/document-materials.js)
 import { defaultSampleId, samples } from '../../lib/samples.js';
+import { documentMaterials, disposeDocumentMaterials, isGltfName } from '../../view/document-materials.js';
 import { attachPointerPicking } from '../../view/pointer-picking.js';
 import { download } from '../download.js';
-import { finder, byId, fromHtml } from '../dom.js';
+import { finder, fromHtml } from '../dom.js';
 import { sampleFiles, userFiles } from '../files.js';
 
 const markup = `
@@ -23,8 +26,10 @@ const markup = `
   <p class="hint">or drop files on the view — a .gltf together with its .bin and textures</p>
   <div class="row">
     <label><input type="checkbox" id="wireframe" /> Wireframe</label>
+    <label title="The file's own glTF materials and textures; off: the plain analysis surface"><input type="checkbox" id="materials" checked /> Materials</label>
     <button id="export" type="button" data-idle>Export GLB</button>
   </div>
+  <p id="materials-note" class="hint"></p>
   <p id="credit" class="hint"></p>
   <div id="pick" class="pick">
     <div id="pick-hover" class="hint">Point at the mesh to pick a vertex; click to pin it.</div>
@@ -52,7 +57,7 @@ export const panel = {
   title: 'Mesh',
   create(app) {
     const { state, viewer, client } = app;
-    Object.assign(state, { mesh: null, loads: 0, exports: 0, pick: null, pinned: null });
+    Object.assign(state, { mesh: null, loads: 0, exports: 0, pick: null, pinned: null, materials: null });
     const root = fromHtml(markup);
     const $ = finder(root);
 
@@ -115,6 +120,9 @@ export const panel = {
       const [main] = files;
       const buffers = {};
       for (const f of files) buffers[f.name] = f.bytes;
+      // The worker gets the bytes (transferred); a glTF's display materials are read from a
+      // copy on this thread once the load succeeded.
+      const copies = isGltfName(main.name) ? files.map((f) => ({ name: f.name, bytes: f.bytes.slice() })) : null;
       const result = await app.runOp(`Loading ${main.name}`, 'load', { name: main.name }, buffers, { restoreKey: 'mesh:main' });
       if (!result) return false;
       const { buffers: b, info } = result;
@@ -127,6 +135,7 @@ export const panel = {
       state.loads += 1;
       viewer.setMesh(b, { open: info.report.boundaryLoopLengths.length > 0 || info.report.components === 0 });
       showPicks();
+      showMaterials(copies, info);
       $('credit').textContent = credit;
       app.setStatus(`${info.name}: ${info.weldedVertices} vertices, ${info.report.faces} faces · cancel: ${client.cancelMode}`);
       app.emit('mesh', state.mesh);
@@ -168,23 +177,43 @@ export const panel = {
       $('file').value = ''; // picking the same file again fires change again
     });
 
-    // Drag and drop on the view.
-    const viewport = byId('viewport');
-    const overlay = fromHtml('<div id="drop-overlay" hidden>Drop mesh files to open them</div>');
-    byId('view').after(overlay);
-    let dragDepth = 0;
-    viewport.addEventListener('dragenter', (e) => { e.preventDefault(); dragDepth += 1; overlay.hidden = false; });
-    viewport.addEventListener('dragleave', () => { dragDepth = Math.max(0, dragDepth - 1); if (!dragDepth) overlay.hidden = true; });
-    viewport.addEventListener('dragover', (e) => e.preventDefault());
-    viewport.addEventListener('drop', (e) => {
-      e.preventDefault();
-      dragDepth = 0;
-      overlay.hidden = true;
-      if (state.busy) return;
-      if (e.dataTransfer?.files?.length) loadUserFiles(e.dataTransfer.files);
-    });
+    // Files dropped on the view while the Mesh or Edit job is shown (the shell routes drops
+    // to the shown job only).
+    const dropTarget = {
+      describe: () => 'Drop mesh files to open them',
+      drop: (files) => loadUserFiles(files),
+    };
+    app.onDrop('mesh', dropTarget);
+    app.onDrop('edit', { ...dropTarget, describe: () => 'Drop mesh files to open them (the edit starts over on the new mesh)' });
 
     $('wireframe').addEventListener('change', () => viewer.setWireframe($('wireframe').checked));
+
+    // ---- the document's own materials (glTF) or the analysis material
+
+    // `shown` is what the mesh is drawn with now (colours of another panel use the analysis
+    // material whatever the toggle says).
+    const materialState = (fields) => ({ ...fields, get shown() { return viewer.shownMaterial; } });
+    async function showMaterials(files, info) {
+      const loads = state.loads;
+      state.materials = materialState({ available: false, textured: false, count: 0, reason: 'not a glTF file', pending: Boolean(files) });
+      $('materials').disabled = true;
+      $('materials-note').textContent = '';
+      if (!files) return;
+      const display = await documentMaterials(files, info.primitives, info.rawVertices);
+      if (loads !== state.loads) { disposeDocumentMaterials(display); return; } // another mesh came meanwhile
+      if (display.error) {
+        state.materials = materialState({ available: false, textured: false, count: 0, reason: display.error });
+        $('materials-note').textContent = `Materials not shown: ${display.error}.`;
+        return;
+      }
+      viewer.setDocumentMaterials(display);
+      state.materials = materialState({ available: true, textured: display.textured, count: display.materials.length, reason: '' });
+      $('materials').disabled = false;
+      $('materials-note').textContent = `${display.materials.length} material${display.materials.length === 1 ? '' : 's'}${display.textured ? ', textured' : ''}`
+        + `${display.missing.length ? ` (missing images: ${display.missing.join(', ')})` : ''}.`;
+      viewer.setMaterialMode($('materials').checked ? 'document' : 'analysis');
+    }
+    $('materials').addEventListener('change', () => viewer.setMaterialMode($('materials').checked ? 'document' : 'analysis'));
 
     // ---- export
 

@@ -21,7 +21,8 @@ import { unweldValues } from '../../lib/arrays.js';
 import { LandmarkPairs, landmarkFile, minLandmarks, readLandmarkFile } from '../../lib/landmarks.js';
 import { samples } from '../../lib/samples.js';
 import { weldedTriangles } from '../../lib/vertex-sets.js';
-import { LandmarkMarkers } from '../../view/landmark-markers.js';
+import { documentMaterials, disposeDocumentMaterials, isGltfName } from '../../view/document-materials.js';
+import { LandmarkMarkers, labelTolerance, pairColor } from '../../view/landmark-markers.js';
 import { VertexMarker } from '../../view/marker.js';
 import { PairView } from '../../view/pair-view.js';
 import { attachPointerPicking } from '../../view/pointer-picking.js';
@@ -56,9 +57,31 @@ const markup = `
     <button id="tr-example" type="button" data-idle title="Cat, pose 07 as the reference and the cat's rest pose as the source (same connectivity)">Load the cat example</button>
   </div>
   <p id="tr-meshes" class="hint"></p>
+  <div class="row" role="radiogroup" aria-label="View">
+    <span class="hint">View</span>
+    <label title="Both meshes in one view, one camera"><input type="radio" name="tr-view" value="side" checked /> Side by side</label>
+    <label title="Two views, each with its own camera"><input type="radio" name="tr-view" value="split" /> Split</label>
+    <label title="Both meshes at the same place, see-through"><input type="radio" name="tr-view" value="overlay" /> Overlay</label>
+  </div>
+  <div class="row">
+    <label title="glTF meshes: their own materials and textures (not in Overlay); off: the plain colours"><input type="checkbox" id="tr-materials" checked /> Materials</label>
+  </div>
+  <div class="row" id="tr-link-row" hidden>
+    <label title="Orbiting one view moves the other the same way"><input type="checkbox" id="tr-link" checked /> Link the cameras</label>
+  </div>
   <h3>Landmarks</h3>
   <p id="tr-landmark-hint" class="hint"></p>
   <p id="tr-hover" class="pick-hover"></p>
+  <div class="row">
+    <button id="tr-suggest" type="button" data-idle title="Pairs at the extremities (tips of limbs, head, tail) found on both meshes; accept or reject each">Suggest pairs</button>
+  </div>
+  <div id="tr-suggestions" hidden>
+    <table class="landmarks suggestions"><thead><tr><th>#</th><th>reference</th><th>source</th><th></th></tr></thead><tbody></tbody></table>
+    <div class="row">
+      <button id="tr-suggest-accept-all" type="button">Accept all</button>
+      <button id="tr-suggest-reject-all" type="button">Reject all</button>
+    </div>
+  </div>
   <div id="tr-table"></div>
   <div class="row">
     <button id="tr-landmarks-clear" type="button" title="Delete every pair">Clear</button>
@@ -111,6 +134,7 @@ export const panel = {
     const transfer = {
       step: 0, reference: null, source: null, sameConnectivity: false, pairs: [], pending: null, selected: -1,
       method: 'yin', result: null, showing: 'result', runs: 0, saved: null, exports: 0,
+      view: 'side', linked: true, suggestions: [], loading: null,
     };
     state.transfer = transfer;
 
@@ -218,7 +242,10 @@ export const panel = {
       const [main] = files;
       const buffers = {};
       for (const f of files) buffers[f.name] = f.bytes;
+      const copies = isGltfName(main.name) ? files.map((f) => ({ name: f.name, bytes: f.bytes.slice() })) : null;
+      transfer.loading = side;
       const loaded = await app.runOp(`Loading ${main.name} (${side})`, 'load', { name: main.name, slot: slots[side] }, buffers, { restoreKey: `mesh:${slots[side]}` });
+      transfer.loading = null;
       if (!loaded) return false;
       const { buffers: b, info } = loaded;
       meshes[side] = {
@@ -228,8 +255,17 @@ export const panel = {
       transfer[side] = { name: info.name, rawVertices: info.rawVertices, weldedVertices: info.weldedVertices };
       app.setStatus(`${side}: ${info.name}, ${info.weldedVertices} vertices, ${info.report.faces} faces · cancel: ${client.cancelMode}`);
       pair.setMesh(side, b, { open: info.report.boundaryLoopLengths.length > 0 || info.report.components === 0 });
-      // A new mesh: pairs and results of the old one mean nothing on it.
+      if (copies) {
+        const entry = meshes[side];
+        documentMaterials(copies, info.primitives, info.rawVertices).then((display) => {
+          if (meshes[side] !== entry || display.error) return disposeDocumentMaterials(display);
+          pair.setDocumentMaterials(side, display);
+          return undefined;
+        });
+      }
+      // A new mesh: pairs, suggestions and results of the old one mean nothing on it.
       landmarks.clear();
+      setSuggestions([]);
       transfer.selected = -1;
       clearResult();
       const { reference, source } = meshes;
@@ -243,11 +279,14 @@ export const panel = {
       const sample = samples.find((s) => s.id === id);
       if (!sample) return false;
       $(`tr-${side}-sample`).value = id;
+      transfer.loading = side; // already while the files are fetched (drops wait for it)
       try {
         return await loadSide(side, await sampleFiles(sample));
       } catch (e) {
         app.showError(e);
         return false;
+      } finally {
+        transfer.loading = null;
       }
     }
 
@@ -335,6 +374,104 @@ export const panel = {
       refresh();
     });
 
+    // ---- suggested pairs (extremities; worker op suggestLandmarks)
+
+    const suggestionBody = root.querySelector('#tr-suggestions tbody');
+    function setSuggestions(list) {
+      transfer.suggestions = list.map((p) => [...p]);
+      $('tr-suggestions').hidden = list.length === 0;
+      suggestionBody.replaceChildren();
+      list.forEach(([r, s], i) => {
+        const row = fromHtml(`<tr data-index="${i}"><td class="pair-number suggested"></td><td>${r}</td><td>${s}</td>
+          <td><button type="button" class="suggest-accept" title="Add this pair">✓</button> <button type="button" class="suggest-reject" title="Drop this suggestion">×</button></td></tr>`);
+        const number = row.querySelector('.pair-number');
+        number.textContent = `S${i + 1}`;
+        number.style.borderColor = `rgb(${pairColor(landmarks.pairs.length + i).map((v) => Math.round(255 * v)).join(', ')})`;
+        row.querySelector('.suggest-accept').addEventListener('click', () => acceptSuggestions([i]));
+        row.querySelector('.suggest-reject').addEventListener('click', () => setSuggestions(transfer.suggestions.filter((_, k) => k !== i)));
+        suggestionBody.append(row);
+      });
+      if (meshes.reference && meshes.source) {
+        markers.showSuggestions(list.map(([r, s]) => [meshes.reference.weldedToRaw[r], meshes.source.weldedToRaw[s]]), landmarks.pairs.length);
+      } else {
+        markers.showSuggestions([], 0);
+      }
+    }
+
+    function acceptSuggestions(indices) {
+      const take = new Set(indices);
+      const kept = [];
+      transfer.suggestions.forEach(([r, s], i) => {
+        if (take.has(i)) landmarks.pairs.push([r, s]);
+        else kept.push([r, s]);
+      });
+      transfer.selected = -1;
+      refresh();
+      setSuggestions(kept);
+    }
+
+    $('tr-suggest').addEventListener('click', async () => {
+      if (!meshes.reference || !meshes.source) {
+        app.showError({ code: 'InvalidArgument', message: 'load the reference and the source first (steps 1 and 2)' });
+        return;
+      }
+      const found = await app.runOp('Finding extremities', 'suggestLandmarks', {
+        referenceSlot: slots.reference, sourceSlot: slots.source, sameConnectivity: transfer.sameConnectivity,
+      });
+      if (!found) return;
+      // Pairs already listed are not suggested again.
+      const taken = new Set(landmarks.pairs.map(([r, s]) => `${r}/${s}`));
+      const fresh = found.info.pairs.filter(([r, s]) => !taken.has(`${r}/${s}`));
+      setSuggestions(fresh.map(([r, s]) => [r, s]));
+      app.setStatus(fresh.length ? `${fresh.length} suggested pairs: accept (✓) or reject (×) each` : 'no matching extremities found: click pairs yourself');
+    });
+    $('tr-suggest-accept-all').addEventListener('click', () => acceptSuggestions(transfer.suggestions.map((_, i) => i)));
+    $('tr-suggest-reject-all').addEventListener('click', () => setSuggestions([]));
+
+    // ---- view: side by side, split (linked or independent cameras), overlay
+
+    function setView(mode) {
+      transfer.view = mode;
+      transfer.linked = $('tr-link').checked;
+      $('tr-link-row').hidden = mode !== 'split';
+      pair.setMode(mode, { linked: transfer.linked });
+      showPaneLabels();
+    }
+    for (const radio of root.querySelectorAll('input[name="tr-view"]')) radio.addEventListener('change', () => setView(radio.value));
+    $('tr-link').addEventListener('change', () => setView(transfer.view));
+    $('tr-materials').addEventListener('change', () => pair.setMaterialMode($('tr-materials').checked ? 'document' : 'analysis'));
+
+    // Names on the panes (split) or the halves (side by side).
+    const paneLabels = fromHtml('<div class="pane-labels" hidden><span>Reference</span><span>Source</span></div>');
+    viewer.renderer.domElement.after(paneLabels);
+    function showPaneLabels() {
+      paneLabels.hidden = !visible || transfer.view !== 'split';
+      paneLabels.classList.toggle('split', transfer.view === 'split');
+    }
+
+    // ---- files dropped on the view while this job is shown: the left half opens the
+    // reference, the right half the source (never the Mesh job's mesh)
+
+    const dropSide = (x) => {
+      const rect = viewer.renderer.domElement.getBoundingClientRect();
+      return x < rect.left + rect.width / 2 ? 'reference' : 'source';
+    };
+    app.onDrop('transfer', {
+      describe: (x) => `Drop here to open the ${dropSide(x)} (${dropSide(x) === 'reference' ? 'left' : 'right'} half)`,
+      async drop(fileList, x) {
+        const side = dropSide(x);
+        if (transfer.loading) {
+          app.refuse({ code: 'Busy', message: `The ${transfer.loading} is still loading: the dropped file was not opened. Drop it again when it has loaded.` });
+          return;
+        }
+        try {
+          if (await loadSide(side, await userFiles(fileList))) $(`tr-${side}-sample`).value = 'file';
+        } catch (e) {
+          app.showError(e);
+        }
+      },
+    });
+
     // ---- run, compare, show
 
     function clearResult() {
@@ -420,8 +557,19 @@ export const panel = {
     app.on('ready', async () => {
       try {
         const schema = (await client.run('optionSchema', { job: 'transfer' }).promise).info;
-        // The method has its own selector above the form.
-        form = new OptionsForm(schema.options.filter((o) => o.name !== 'method'), { title: 'Options' });
+        // The method has its own selector above the form: its choices, default and help come
+        // from the schema too (the labels above only name the papers).
+        const method = schema.options.find((o) => o.name === 'method');
+        if (method) {
+          const select = $('tr-method');
+          for (const choice of method.choices || []) {
+            if (![...select.options].some((o) => o.value === choice)) select.add(new Option(choice, choice));
+          }
+          for (const o of [...select.options]) if (!(method.choices || []).includes(o.value)) o.remove();
+          select.value = method.default;
+          select.title = method.help;
+        }
+        form = new OptionsForm(schema.options.filter((o) => o.name !== 'method'), { title: 'Transfer options' });
         $('tr-options').append(form.element);
       } catch (e) {
         app.showError(e);
@@ -433,6 +581,7 @@ export const panel = {
       visible = job === 'transfer';
       if (visible === was) return;
       pair.setActive(visible);
+      showPaneLabels();
       if (!visible) {
         hoverMarker.hide();
         viewer.frame(); // the Mesh / Edit jobs' mesh, framed as they left it
@@ -441,7 +590,16 @@ export const panel = {
     // A mesh loaded in the Mesh job frames the camera on it; while the pair is shown, frame it.
     app.on('mesh', () => { if (visible) pair.frame(); });
 
-    app.hooks.transferVertexOnScreen = (side, vertex) => vertexOnScreen(viewer, vertex, pair.sides[side]);
+    // tolerance: see view/screen-space.js vertexVisible (labels use labelTolerance).
+    app.hooks.transferVertexOnScreen = (side, vertex, tolerance = undefined) => vertexOnScreen(viewer, vertex, { ...pair.sides[side], ...pair.view(side), tolerance });
+    app.hooks.labelTolerance = labelTolerance;
+    app.hooks.transferLabels = () => markers.labels();
+    app.hooks.transferMaterials = () => pair.shownMaterials();
+    app.hooks.transferCameras = () => [0, 1].map((i) => ({
+      position: viewer.paneCamera(i).position.toArray(), target: (i ? viewer.controls2 : viewer.controls).target.toArray(),
+    }));
+    // Welded → raw for a side (tests place the pointer on displayed vertices).
+    app.hooks.transferRawVertex = (side, welded) => meshes[side]?.weldedToRaw[welded] ?? -1;
     app.hooks.transferResult = () => (result ? Array.from(result) : null);
     app.hooks.transferShown = (side = 'source') => Array.from(pair.sides[side].mesh.geometry.getAttribute('position').array);
     refresh();

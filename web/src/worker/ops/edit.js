@@ -6,7 +6,10 @@
 //
 // Positions come back twice: `positions` on the welded mesh (#W·3, what core computed, what the
 // export op takes) and `rawPositions` in the loaded file's vertex layout (#R·3, through the
-// asset's toWelded map) for swapping into the three.js BufferGeometry directly.
+// asset's toWelded map) for swapping into the three.js BufferGeometry directly, with
+// `rawNormals` (smooth normals of the welded surface, raw layout, as the load op gives): the
+// page's main thread does no per-vertex work while a gizmo is dragged.
+import { vertexNormals } from '../../lib/arrays.js';
 import { MeshMorphError, unwrap } from '../../lib/errors.js';
 import { defaultSlot, meshInSlot } from './mesh.js';
 
@@ -44,8 +47,9 @@ function unweld(positions, toWelded) {
 
 function positionsResult(ctx, entry, result, started, extraInfo = {}) {
   const r = unwrap(result);
+  const normals = vertexNormals(r.positions, meshInSlot(ctx, entry.slot).weldedIndices);
   return {
-    buffers: { positions: r.positions, rawPositions: unweld(r.positions, entry.toWelded) },
+    buffers: { positions: r.positions, rawPositions: unweld(r.positions, entry.toWelded), rawNormals: unweld(normals, entry.toWelded) },
     info: { slot: entry.slot, milliseconds: Date.now() - started, ...extraInfo },
   };
 }

@@ -2,6 +2,7 @@
 // host (tests/js/node_worker.mjs) register exactly these. A new job adds its file here
 // (one import, one entry); each file exports `ops = {opName: (ctx, options, buffers) => …}`
 // (see mesh.js for the signature and ctx).
+import * as debug from './debug.js';
 import * as edit from './edit.js';
 import * as mesh from './mesh.js';
 import * as retarget from './retarget.js';
@@ -12,4 +13,5 @@ export const opFiles = {
   'edit.js': edit,
   'transfer.js': transfer,
   'retarget.js': retarget,
+  'debug.js': debug,
 };
