@@ -77,15 +77,17 @@ void edit_suite(Context& ctx) {
              "nnz(lower) " + std::to_string(st.system_nonzeros)});
     ctx.add({"edit", name, n, "  factor AtA (Eq. 7)", st.factor_ms, p ? "paper 001: 4.813 s" : "",
              p ? "libigl LtL factor 1.54 s" : ""});
-    ctx.add({"edit", name, n, "  handle basis (4 solves/handle)", st.basis_ms, "", ""});
+    ctx.add({"edit", name, n, "  handle basis (4 solves/handle)", st.basis_ms, "",
+             std::to_string(st.basis_refinements) + " refinement step(s)"});
     ctx.add({"edit", name, n, "  Poisson factor (Eq. 9/10)", st.poisson_ms, p ? "paper 001: 0.875 s" : "", ""});
     EditResult r;
     ctx.add({"edit", name, n, "drag (handle basis)", ctx.time_ms([&] { r = ed.drag({T}); }, 5),
              p ? "paper 001 solve: 0.188 s" : "", p ? "libigl drag 61 ms" : ""});
     Eigen::MatrixXd targets = m.V;
     for (int v : region.handles[0]) targets.row(v) = T.apply(m.V.row(v).transpose()).transpose();
-    ctx.add({"edit", name, n, "drag (3 back-substitutions)", ctx.time_ms([&] { r = ed.drag_positions(targets); }, 5),
-             p ? "paper 001 solve: 0.188 s" : "", p ? "libigl drag 61 ms" : ""});
+    const double t_pos = ctx.time_ms([&] { r = ed.drag_positions(targets); }, 5);
+    ctx.add({"edit", name, n, "drag (3 back-substitutions)", t_pos, p ? "paper 001 solve: 0.188 s" : "",
+             std::string(p ? "libigl drag 61 ms; " : "") + std::to_string(r.refinements) + " refinement step(s)"});
     ctx.add({"edit", name, n, "finalize (polar + solve)", ctx.time_ms([&] { r = ed.finalize(); }, 5),
              p ? "paper 001: 0.985 + 0.078 s" : "", r.status.ok() ? "" : r.status.message});
   }

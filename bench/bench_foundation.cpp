@@ -7,6 +7,7 @@
 #include "bench.h"
 #include "io/asset.h"
 #include "linalg/spd_solver.h"
+#include "mesh/topology.h"
 #include "mesh/weld.h"
 #include "operators/operators.h"
 #include "spectral/spectral_basis.h"
@@ -46,6 +47,9 @@ void foundation_suite(Context& ctx) {
     WeldResult w;
     ctx.add({"foundation", name, n, "weld",
              ctx.time_ms([&] { w = weld_vertices(lr.asset.V_raw, lr.asset.F_raw); }, 5), "", ""});
+    std::vector<std::vector<int>> loops;
+    ctx.add({"foundation", name, n, "boundary loops",
+             ctx.time_ms([&] { loops = boundary_loops(m.F, n); }, 5), "", std::to_string(loops.size()) + " loops"});
     SparseMatrix W;
     Eigen::VectorXd a;
     ctx.add({"foundation", name, n, "cotan + Voronoi mass",
@@ -71,8 +75,36 @@ void foundation_suite(Context& ctx) {
   }
 }
 
+// Loading at scale (issue 18): weld and boundary tracing of an axis-aligned k by k grid (every x
+// coordinate shared by k vertices: the case that was quadratic), at 10k, 100k and 1M vertices;
+// the time should grow linearly.
+void loading_suite(Context& ctx) {
+  for (int k : {100, 316, 1000}) {
+    if (ctx.quick && k == 1000) continue;
+    Eigen::MatrixXd V(static_cast<Eigen::Index>(k) * k, 3);
+    for (int j = 0; j < k; ++j)
+      for (int i = 0; i < k; ++i) V.row(static_cast<Eigen::Index>(j) * k + i) << i, j, 0.0;
+    Eigen::MatrixXi F(2 * static_cast<Eigen::Index>(k - 1) * (k - 1), 3);
+    Eigen::Index f = 0;
+    for (int j = 0; j + 1 < k; ++j)
+      for (int i = 0; i + 1 < k; ++i) {
+        const int a = j * k + i, b = a + 1, c = a + k, d = c + 1;
+        F.row(f++) << a, b, d;
+        F.row(f++) << a, d, c;
+      }
+    const int n = static_cast<int>(V.rows());
+    const std::string name = "grid " + std::to_string(k) + "x" + std::to_string(k);
+    WeldResult w;
+    ctx.add({"loading", name, n, "weld", ctx.time_ms([&] { w = weld_vertices(V, F); }, 3), "", ""});
+    std::vector<std::vector<int>> loops;
+    ctx.add({"loading", name, n, "boundary loops", ctx.time_ms([&] { loops = boundary_loops(F, n); }, 3), "",
+             std::to_string(loops.size()) + " loop(s)"});
+  }
+}
+
 }  // namespace
 
 MM_BENCH(foundation, foundation_suite);
+MM_BENCH(loading, loading_suite);
 
 }  // namespace mm::bench

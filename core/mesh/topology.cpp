@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <functional>
-#include <map>
 #include <numeric>
 #include <queue>
 
@@ -140,31 +139,62 @@ std::vector<VertexFans> non_manifold_vertices(const Eigen::MatrixXi& F, int n, c
 }
 
 std::vector<std::vector<int>> boundary_loops(const Eigen::MatrixXi& F, int n) {
-  // Directed boundary half-edges a->b (face order) whose edge is used by exactly one face.
-  std::map<std::pair<int, int>, int> count;
-  for (int f = 0; f < F.rows(); ++f)
+  // Linear time, no ordered maps (1M-vertex grids): face edges (slots 3f + c) bucketed by their
+  // smaller vertex, each bucket sorted by the larger one (buckets are a vertex's few edges), runs
+  // counted; the directed half-edges a→b (face order) of edges used once are bucketed by a,
+  // ascending, and chained with a cursor per vertex.
+  const int nf = static_cast<int>(F.rows());
+  auto valid = [n](int a, int b) { return a != b && a >= 0 && b >= 0 && a < n && b < n; };
+  std::vector<int> start(static_cast<size_t>(n) + 1, 0);
+  for (int f = 0; f < nf; ++f)
     for (int c = 0; c < 3; ++c) {
-      int a = F(f, c), b = F(f, (c + 1) % 3);
-      if (a == b || a < 0 || b < 0 || a >= n || b >= n) continue;
-      ++count[{std::min(a, b), std::max(a, b)}];
+      const int a = F(f, c), b = F(f, (c + 1) % 3);
+      if (valid(a, b)) ++start[std::min(a, b) + 1];
     }
-  std::vector<std::vector<int>> next(n);  // outgoing boundary half-edges per vertex
-  for (int f = 0; f < F.rows(); ++f)
-    for (int c = 0; c < 3; ++c) {
-      int a = F(f, c), b = F(f, (c + 1) % 3);
-      if (a == b || a < 0 || b < 0 || a >= n || b >= n) continue;
-      if (count[{std::min(a, b), std::max(a, b)}] == 1) next[a].push_back(b);
+  for (int v = 0; v < n; ++v) start[v + 1] += start[v];
+  std::vector<std::pair<int, int>> bucket(start[n]);  // (larger vertex, slot)
+  {
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (int f = 0; f < nf; ++f)
+      for (int c = 0; c < 3; ++c) {
+        const int a = F(f, c), b = F(f, (c + 1) % 3);
+        if (valid(a, b)) bucket[fill[std::min(a, b)]++] = {std::max(a, b), 3 * f + c};
+      }
+  }
+  std::vector<char> single(3 * static_cast<size_t>(nf), 0);  // per slot: its edge has one face
+  for (int v = 0; v < n; ++v) {
+    const auto first = bucket.begin() + start[v], last = bucket.begin() + start[v + 1];
+    std::sort(first, last);
+    for (auto k = first; k != last;) {
+      auto e = k;
+      while (e != last && e->first == k->first) ++e;
+      if (e - k == 1) single[k->second] = 1;
+      k = e;
     }
-  for (auto& l : next) std::sort(l.begin(), l.end());
+  }
+  std::vector<int> out_start(static_cast<size_t>(n) + 1, 0);
+  for (int f = 0; f < nf; ++f)
+    for (int c = 0; c < 3; ++c)
+      if (single[3 * f + c]) ++out_start[F(f, c) + 1];
+  for (int v = 0; v < n; ++v) out_start[v + 1] += out_start[v];
+  std::vector<int> next(out_start[n]);  // outgoing boundary half-edges per vertex, ascending
+  {
+    std::vector<int> fill(out_start.begin(), out_start.end() - 1);
+    for (int f = 0; f < nf; ++f)
+      for (int c = 0; c < 3; ++c)
+        if (single[3 * f + c]) next[fill[F(f, c)]++] = F(f, (c + 1) % 3);
+  }
+  std::vector<int> cursor(out_start.begin(), out_start.end() - 1);
+  for (int v = 0; v < n; ++v) std::sort(next.begin() + out_start[v], next.begin() + out_start[v + 1]);
+  auto remaining = [&](int v) { return cursor[v] < out_start[v + 1]; };
   std::vector<std::vector<int>> loops;
-  for (int start = 0; start < n; ++start) {
-    while (!next[start].empty()) {
-      std::vector<int> loop{start};
-      int v = start;
-      while (!next[v].empty()) {
-        const int w = next[v].front();
-        next[v].erase(next[v].begin());
-        if (w == start) break;
+  for (int s = 0; s < n; ++s) {
+    while (remaining(s)) {
+      std::vector<int> loop{s};
+      int v = s;
+      while (remaining(v)) {
+        const int w = next[cursor[v]++];  // the smallest unused successor
+        if (w == s) break;
         loop.push_back(w);
         v = w;
       }

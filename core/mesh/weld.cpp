@@ -1,6 +1,8 @@
 #include "mesh/weld.h"
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -10,6 +12,67 @@
 
 namespace mm {
 
+namespace {
+
+// Open-addressing hash map from a cell (three int32 coordinates) to a dense cell id (ids in
+// insertion order); lookups only, so the result never depends on the table's layout. 16-byte
+// slots with the key inside: one cache line per probe, and an uninitialised key array (the table
+// is 2–4 slots per vertex; at 1M vertices its size and random accesses are the weld's cost).
+class CellTable {
+ public:
+  using Key = std::array<int32_t, 3>;
+  explicit CellTable(size_t expected) {
+    size_t cap = 16;
+    while (cap < 2 * expected) cap <<= 1;
+    slots_.resize(cap);
+    mask_ = cap - 1;
+  }
+  // Id of the cell, inserting it when new.
+  int insert(const Key& k) {
+    size_t h = hash(k) & mask_;
+    while (slots_[h].id >= 0) {
+      if (same(slots_[h].key, k)) return slots_[h].id;
+      h = (h + 1) & mask_;
+    }
+    slots_[h].key = k;
+    return slots_[h].id = count_++;
+  }
+  int find(const Key& k) const {
+    size_t h = hash(k) & mask_;
+    while (slots_[h].id >= 0) {
+      if (same(slots_[h].key, k)) return slots_[h].id;
+      h = (h + 1) & mask_;
+    }
+    return -1;
+  }
+  int size() const { return count_; }
+
+ private:
+  struct Slot {
+    Slot() {}  // key left uninitialised on purpose (read only when id ≥ 0)
+    Key key;
+    int id = -1;
+  };
+  static bool same(const Key& a, const Key& b) { return a[0] == b[0] && a[1] == b[1] && a[2] == b[2]; }
+  // Cell coordinates are regular (grids: multiples of one step), so every bit is mixed before the
+  // low bits index the table: MurmurHash3's 64-bit finalizer.
+  static size_t hash(const Key& k) {
+    uint64_t x = (static_cast<uint64_t>(static_cast<uint32_t>(k[0])) << 32) ^ static_cast<uint32_t>(k[1]);
+    x ^= static_cast<uint64_t>(static_cast<uint32_t>(k[2])) * 0x9E3779B97F4A7C15ULL;
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdULL;
+    x ^= x >> 33;
+    x *= 0xc4ceb9fe1a85ec53ULL;
+    x ^= x >> 33;
+    return static_cast<size_t>(x);
+  }
+  std::vector<Slot> slots_;
+  size_t mask_ = 0;
+  int count_ = 0;
+};
+
+}  // namespace
+
 WeldResult weld_vertices(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const WeldOptions& opt) {
   const int n = static_cast<int>(V.rows());
   WeldResult out;
@@ -17,36 +80,117 @@ WeldResult weld_vertices(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, con
   double tol = 0;
   if (V.allFinite()) tol = opt.tolerance * bounding_box_diagonal(V);
 
-  // Sort vertices by x, then sweep: candidates for merging lie within tol in x.
-  // Each vertex joins the group of the earliest (lowest index) vertex within tol, so
-  // numbering follows first occurrence and is independent of the sort.
-  std::vector<int> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  // Non-finite vertices sort last and are never merged (NaN breaks the ordering otherwise).
-  std::vector<double> key(n);
-  for (int v = 0; v < n; ++v)
-    key[v] = V.row(v).allFinite() ? V(v, 0) : std::numeric_limits<double>::infinity();
-  std::sort(order.begin(), order.end(), [&key](int a, int b) {
-    if (key[a] != key[b]) return key[a] < key[b];
-    return a < b;
-  });
-  // Union-find whose root is always the smallest index of its group.
+  // Contract (unchanged from the x-sweep this replaces): vertices a, b are merged, transitively,
+  // when |x_a − x_b| ≤ tol and |v_a − v_b|² ≤ tol² as computed in doubles (tol = 0: identical
+  // coordinates, −0 = +0); non-finite vertices never merge; union-find whose root is always the
+  // smallest index of its group, so numbering follows first occurrence and does not depend on
+  // the order in which pairs are found. Pairs are found through a spatial hash in linear time,
+  // whatever the number of vertices sharing a coordinate (grids, CAD and voxel meshes):
+  //  - cells of size c ≥ 2·tol, so a partner is at most one cell away per axis, and only on a
+  //    side the vertex is within tol of. c is as large as a quarter of the typical vertex spacing
+  //    allows (up to 1024·tol): most vertices then lie far from every cell side and need no
+  //    lookup besides their own cell. The grid starts half a cell below the bounding box, so
+  //    flat meshes lying in a bounding plane are not all at a cell side;
+  //  - tol = 0: identical positions share a cell; only the cell itself is searched.
   std::vector<int> rep(n);
   std::iota(rep.begin(), rep.end(), 0);
   auto find = [&rep](int x) {
     while (rep[x] != x) x = rep[x] = rep[rep[x]];
     return x;
   };
+  auto unite = [&](int a, int b) {
+    const int ra = find(a), rb = find(b);
+    if (ra != rb) rep[std::max(ra, rb)] = std::min(ra, rb);
+  };
+  std::vector<char> finite(n);
+  Eigen::Array3d lo = Eigen::Array3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (int v = 0; v < n; ++v) {
+    finite[v] = V.row(v).allFinite();
+    if (!finite[v]) continue;
+    lo = lo.min(V.row(v).transpose().array());
+    hi = hi.max(V.row(v).transpose().array());
+  }
+  const double extent = n > 0 && (hi >= lo).all() ? (hi - lo).maxCoeff() : 0.0;
+  const double spacing = std::sqrt(3.0) * extent / std::sqrt(static_cast<double>(std::max(n, 1)));
+  // 1e-9·extent keeps cell coordinates below ~1e9 (int32) whatever the tolerance: a larger cell
+  // only adds candidates.
+  double c = std::max(tol > 0 ? std::min(1024 * tol, 0.25 * spacing) : 0.25 * spacing, 1e-9 * extent);
+  c = std::max(c, 2 * tol);
+  if (!(c > 0)) c = 1.0;  // all finite vertices coincide (or none): one cell
+  const Eigen::Array3d origin = lo - 0.5 * c;
+  auto cell_key = [&](int v, Eigen::Array3d* frac) {
+    CellTable::Key k;
+    for (int a = 0; a < 3; ++a) {
+      const double q = (V(v, a) - origin[a]) / c, f = std::floor(q);
+      k[a] = static_cast<int32_t>(f);
+      (*frac)[a] = q - f;
+    }
+    return k;
+  };
+  CellTable table(static_cast<size_t>(n));
+  std::vector<int> cell(n, -1);
+  std::vector<Eigen::Array3d> fracs(n);
+  for (int v = 0; v < n; ++v)
+    if (finite[v]) cell[v] = table.insert(cell_key(v, &fracs[v]));
+  // Vertices per cell, ascending (CSR).
+  const int cells = table.size();
+  std::vector<int> start(cells + 1, 0), members(n);
+  for (int v = 0; v < n; ++v)
+    if (cell[v] >= 0) ++start[cell[v] + 1];
+  for (int k = 0; k < cells; ++k) start[k + 1] += start[k];
+  {
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (int v = 0; v < n; ++v)
+      if (cell[v] >= 0) members[fill[cell[v]]++] = v;
+  }
   const double tol2 = tol * tol;
-  for (size_t s = 0; s < order.size(); ++s) {
-    const int a = order[s];
-    for (size_t t = s + 1; t < order.size(); ++t) {
-      const int b = order[t];
-      if (!std::isfinite(key[b]) || key[b] - key[a] > tol) break;
-      if ((V.row(a) - V.row(b)).squaredNorm() <= tol2) {
-        const int ra = find(a), rb = find(b);
-        if (ra != rb) rep[std::max(ra, rb)] = std::min(ra, rb);
+  if (tol == 0) {
+    // Identical positions: each cell's distinct positions (usually one) with their first vertex.
+    std::vector<int> firsts;
+    for (int k = 0; k < cells; ++k) {
+      firsts.clear();
+      for (int i = start[k]; i < start[k + 1]; ++i) {
+        const int v = members[i];
+        bool found = false;
+        for (int f : firsts)
+          if (V(f, 0) == V(v, 0) && V(f, 1) == V(v, 1) && V(f, 2) == V(v, 2)) {
+            unite(f, v);
+            found = true;
+            break;
+          }
+        if (!found) firsts.push_back(v);
       }
+    }
+  } else {
+    constexpr double kMargin = 1e-6;         // in cells; far above the rounding of q
+    const double reach = tol / c + kMargin;  // ≤ 0.5 + margin: a partner's offset, in cells
+    auto close = [&](int a, int b) {
+      return std::abs(V(a, 0) - V(b, 0)) <= tol && (V.row(a) - V.row(b)).squaredNorm() <= tol2;
+    };
+    for (int a = 0; a < n; ++a) {
+      if (cell[a] < 0) continue;
+      for (int i = start[cell[a]]; i < start[cell[a] + 1]; ++i)
+        if (members[i] > a && close(a, members[i])) unite(a, members[i]);
+      const Eigen::Array3d& frac = fracs[a];
+      int lo_d[3], hi_d[3];
+      bool near_side = false;
+      for (int ax = 0; ax < 3; ++ax) {
+        lo_d[ax] = frac[ax] <= reach ? -1 : 0;
+        hi_d[ax] = frac[ax] >= 1 - reach ? 1 : 0;
+        near_side = near_side || lo_d[ax] || hi_d[ax];
+      }
+      if (!near_side) continue;
+      Eigen::Array3d unused;
+      const CellTable::Key k = cell_key(a, &unused);
+      for (int dx = lo_d[0]; dx <= hi_d[0]; ++dx)
+        for (int dy = lo_d[1]; dy <= hi_d[1]; ++dy)
+          for (int dz = lo_d[2]; dz <= hi_d[2]; ++dz) {
+            if ((dx | dy | dz) == 0) continue;
+            const int id = table.find({k[0] + dx, k[1] + dy, k[2] + dz});
+            if (id < 0) continue;
+            for (int i = start[id]; i < start[id + 1]; ++i)
+              if (members[i] > a && close(a, members[i])) unite(a, members[i]);
+          }
     }
   }
   for (int v = 0; v < n; ++v) rep[v] = find(v);
