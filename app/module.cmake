@@ -6,5 +6,6 @@ list(APPEND MM_CORE_SOURCES
   app/edit_spec.cpp
   app/edit_job.cpp
   app/retarget_job.cpp
-  app/merge_job.cpp)
+  app/merge_job.cpp
+  app/jobs.cpp)
 list(APPEND MM_TEST_SOURCES tests/app_test.cpp)

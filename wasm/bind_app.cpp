@@ -2,16 +2,14 @@
 // options panels (the same schema gives the CLI its flags and --help, see app/option_schema.h).
 //
 // JS API:
-//   optionSchema(job: "edit" | "transfer" | "retarget")
+//   optionSchema(job: "edit" | "merge" | "transfer" | "retarget")  (app/jobs.h)
 //     → {ok, schema: {job, summary, options: [{name, kind, default, min?, max?, choices?, flag, help}]}}
 #include <string>
 
 #include <emscripten/bind.h>
 #include <emscripten/val.h>
 
-#include "app/edit_job.h"
-#include "app/retarget_job.h"
-#include "app/transfer_job.h"
+#include "app/jobs.h"
 #include "convert.h"
 #include "guard.h"
 
@@ -20,12 +18,11 @@ namespace {
 
 emscripten::val option_schema_js(const std::string& job) {
   std::string json;
-  if (job == "edit") json = app::edit_options().json();
-  else if (job == "transfer") json = app::transfer_options().json();
-  else if (job == "retarget") json = app::retarget_options().json();
-  else
+  for (const app::JobSchema& j : app::job_schemas())
+    if (j.name == job) json = j.json;
+  if (json.empty())
     return status_object(Status::error(StatusCode::InvalidArgument,
-                                       "no job named '" + job.substr(0, 40) + "' (edit, transfer, retarget)"));
+                                       "no job named '" + job.substr(0, 40) + "' (" + app::job_names() + ")"));
   emscripten::val out = status_object(Status::success());
   out.set("schema", emscripten::val::global("JSON").call<emscripten::val>("parse", json));
   return out;

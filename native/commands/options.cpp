@@ -2,10 +2,7 @@
 // description the CLI flags, the wasm bindings and the page's options panels are generated from.
 #include <iostream>
 
-#include "app/edit_job.h"
-#include "app/merge_job.h"
-#include "app/retarget_job.h"
-#include "app/transfer_job.h"
+#include "app/jobs.h"
 #include "cli.h"
 
 namespace mm::cli {
@@ -24,22 +21,15 @@ int run_options(const std::vector<std::string>& argv) {
   const bool json = args.has("json");
   args.get("json");
   const std::string only = args.positional().empty() ? "" : args.positional()[0];
-  struct Job {
-    std::string name, json, help;
-  };
-  const Job jobs[] = {{"edit", app::edit_options().json(), app::edit_options().help()},
-                      {"merge", app::merge_options().json(), app::merge_options().help()},
-                      {"transfer", app::transfer_options().json(), app::transfer_options().help()},
-                      {"retarget", app::retarget_options().json(), app::retarget_options().help()}};
   bool found = only.empty();
   std::string out;
-  for (const Job& j : jobs) {
+  for (const app::JobSchema& j : app::job_schemas()) {
     if (!only.empty() && j.name != only) continue;
     found = true;
     if (json) out += (out.empty() ? "" : ",\n") + j.json;
     else out += j.name + ":\n" + j.help;
   }
-  if (!found) return report("options", Status::error(StatusCode::InvalidArgument, "no job named '" + only.substr(0, 40) + "' (edit, merge, transfer, retarget)"));
+  if (!found) return report("options", Status::error(StatusCode::InvalidArgument, "no job named '" + only.substr(0, 40) + "' (" + app::job_names() + ")"));
   std::cout << (json ? "{\"jobs\": [" + out + "]}\n" : out);
   return 0;
 }
