@@ -167,14 +167,26 @@ export class MergeView {
 
   request() { this.viewer.requestRender(); }
 
-  // Shows the merge scene instead of the viewer's own mesh (or gives the view back).
+  // Shows the merge scene instead of the viewer's own mesh (or gives the view back). Jobs
+  // switch in panel order, so the job shown next may already have put up its own scene group
+  // (the Transfer job's pair view): then the viewer's mesh stays hidden and its camera stays.
   setActive(on) {
     if (this.root.visible === on) return;
     this.root.visible = on;
-    this.viewer.setMainVisible(!on);
     this.gizmo.enabled = on && Boolean(this.gizmoKind);
-    if (on) this.frameCamera();
+    if (on) {
+      this.viewer.setMainVisible(false);
+      this.frameCamera();
+    } else if (!this.otherViewShown()) {
+      this.viewer.setMainVisible(true);
+      this.viewer.frame();
+    }
     this.request();
+  }
+
+  otherViewShown() {
+    const { scene, overlays } = this.viewer;
+    return scene.children.some((c) => c.isGroup && c !== this.root && c !== overlays && c.visible);
   }
 
   // ---- meshes

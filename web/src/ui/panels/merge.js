@@ -1027,7 +1027,6 @@ export const panel = {
       if (!visible) {
         view.showHover(null);
         setBrush(false);
-        viewer.frame();
       } else if (merge.mode === 'dependent') {
         attachPlacementGizmo();
       }
