@@ -146,9 +146,13 @@ export function registerMergeTests(it, { check, shot, nextFrame, waitIdle, canva
     check(JSON.stringify(m.pairs) === JSON.stringify([[tk[0], sk[0]], [tk[1], sk[1]]]), `pairs ${JSON.stringify(m.pairs)}`);
     check(m.step === 4 && !m.problem, `after two pairs: step ${m.step}, problem ${m.problem}`);
     check(await page.locator('table.merge-keys tbody tr').count() === 2, 'the table does not list 2 pairs');
-    await page.click('#mg-source-look');
+    await page.click('#mg-frame');
     await nextFrame(page);
     await shot(page, 'merge-3-keys');
+    await page.click('#mg-source-look');
+    await nextFrame(page);
+    await shot(page, 'merge-3-keys-look-source');
+    await page.click('#mg-frame');
 
     // A third pair out of order: the page says so, Merge refuses with a readable message; the
     // pair goes with ×; reordering swaps rows.

@@ -4,10 +4,13 @@
 // result with its seam.
 //
 // Arrangements (setArrangement):
-//   'apart'   the two meshes side by side, each scaled to bounding radius 1 (the target left):
-//             the configuration-independent mode, where the source's placement does not matter
-//   'placed'  the source where `placement` (a 4x4 from source to target coordinates) puts it,
-//             in the target's frame: the configuration-dependent mode, moved with the gizmo
+//   'apart'     the two meshes side by side, each scaled to bounding radius 1 (the target left):
+//               before both boundary loops are known
+//   'exploded'  the source turned and scaled as it will attach (setExploded: a 4x4 from source
+//               to target coordinates), pulled out of the target's opening: the
+//               configuration-independent mode, where the source's own placement does not matter
+//   'placed'    the source where `placement` (a 4x4 from source to target coordinates) puts it,
+//               in the target's frame: the configuration-dependent mode, moved with the gizmo
 // and the result (showResult) in the target's frame. The target's frame is the target scaled to
 // radius 1 about its bounding-box centre. Vertices given to and returned from this module are
 // displayed (raw) indices unless named `welded`; points named `local` are a mesh's own
@@ -22,7 +25,7 @@ import { VertexPicker, ndcFromClient } from './picking.js';
 import { vertexVisible } from './screen-space.js';
 
 export const mergeSides = ['target', 'source'];
-export const sideColors = { target: [0.73, 0.78, 0.88], source: [0.85, 0.8, 0.74] };
+export const sideColors = { target: [0.66, 0.74, 0.9], source: [0.92, 0.8, 0.62] };
 const loopColors = { chosen: 0xffd23f, other: 0x4fc3d9 };
 const seamColor = 0xff7a2f;
 const gap = 0.25;
@@ -54,7 +57,8 @@ function labelSprite(text, rgb) {
   const texture = new THREE.CanvasTexture(canvas);
   texture.colorSpace = THREE.SRGBColorSpace;
   // Numbers stay readable where the surface hides their vertex (a key on the far side of a rim).
-  const sprite = new THREE.Sprite(new THREE.SpriteMaterial({ map: texture, depthTest: false }));
+  // Constant size on the screen (sizeAttenuation off): readable whatever the zoom.
+  const sprite = new THREE.Sprite(new THREE.SpriteMaterial({ map: texture, depthTest: false, sizeAttenuation: false }));
   sprite.center.set(-0.15, -0.15);
   sprite.renderOrder = 3;
   return sprite;
@@ -105,6 +109,8 @@ export class MergeView {
     this.root.add(this.sides.source.mesh);
     this.arrangement = 'apart';
     this.placement = new THREE.Matrix4();
+    this.exploded = new THREE.Matrix4();
+    this.viewDirection = null; // [x, y, z] the camera looks from (exploded / placed), or null
     this.showingResult = false;
     this.raycaster = new THREE.Raycaster();
     this.size = new THREE.Vector2();
@@ -328,7 +334,7 @@ export class MergeView {
     const side = this.sides[pick.side];
     side.overlay.add(this.hover);
     this.hover.position.copy(this.localPoint(pick.side, pick.welded));
-    this.hover.scale.setScalar(side.radius * 0.014);
+    this.hover.scale.setScalar(this.markerSize(pick.side) * 1.1);
     this.hover.visible = true;
     this.request();
   }
@@ -353,15 +359,31 @@ export class MergeView {
     this.request();
   }
 
+  // The size of a side's markers (local units): a fraction of its chosen loop's radius (the
+  // keys sit on it), else of the mesh.
+  markerSize(name) {
+    const side = this.sides[name];
+    const loop = side.loops[side.chosenLoop];
+    if (!loop) return side.radius * 0.015;
+    let length = 0;
+    loop.forEach((w, i) => { length += this.localPoint(name, w).distanceTo(this.localPoint(name, loop[(i + 1) % loop.length])); });
+    return Math.min(side.radius * 0.015, (0.06 * length) / (2 * Math.PI));
+  }
+
   addMarker(name, welded, rgb, text, big) {
     const side = this.sides[name];
     if (!side.loaded) return;
     const group = new THREE.Group();
     const sphere = new THREE.Mesh(sphereGeometry, new THREE.MeshBasicMaterial({ color: new THREE.Color(...rgb) }));
-    sphere.scale.setScalar(side.radius * (big ? 0.024 : 0.017));
+    sphere.scale.setScalar(this.markerSize(name) * (big ? 1.4 : 1));
     sphere.renderOrder = 2;
     const sprite = labelSprite(text, rgb);
-    sprite.scale.setScalar(side.radius * (big ? 0.13 : 0.1));
+    // Screen size: ~26 CSS pixels (30 for the selected / waiting one) over the parent's scale.
+    this.root.updateMatrixWorld(true);
+    const worldScale = new THREE.Vector3().setFromMatrixScale(side.mesh.matrixWorld).x || 1;
+    const rect = this.viewer.renderer.domElement.getBoundingClientRect();
+    const ndc = (2 * (big ? 30 : 26)) / (rect.height || 800);
+    sprite.scale.setScalar((ndc * Math.tan(THREE.MathUtils.degToRad(this.viewer.camera.fov) / 2)) / worldScale);
     group.add(sphere, sprite);
     group.position.copy(this.localPoint(name, welded));
     side.overlay.add(group);
@@ -385,21 +407,31 @@ export class MergeView {
 
   // ---- layout and camera
 
-  setArrangement(arrangement) {
+  // arrangement: 'apart' | 'exploded' | 'placed'; viewDirection: where the camera looks from
+  // (world, [x, y, z]) or null for the default. The camera is framed again when the arrangement
+  // changes or `frame` is true.
+  setArrangement(arrangement, { viewDirection = this.viewDirection, frame = false } = {}) {
+    const changed = arrangement !== this.arrangement;
     this.arrangement = arrangement;
+    this.viewDirection = viewDirection;
     this.layout();
-    this.frameCamera();
+    if (changed || frame) this.frameCamera();
+  }
+
+  setExploded(elements) {
+    this.exploded.fromArray(elements);
+    this.layout();
   }
 
   layout() {
     const { target, source } = this.sides;
     const shift = (x) => new THREE.Matrix4().makeTranslation(x, 0, 0);
-    const apart = this.arrangement === 'apart' && !this.showingResult;
-    this.frame.matrix.copy(apart && source.loaded ? shift(-(1 + gap / 2)).multiply(target.normalization) : target.normalization);
-    if (apart || !target.loaded) {
+    const apart = (this.arrangement === 'apart' || !target.loaded) && !this.showingResult;
+    this.frame.matrix.copy(apart && source.loaded && target.loaded ? shift(-(1 + gap / 2)).multiply(target.normalization) : target.normalization);
+    if (apart) {
       source.mesh.matrix.copy(target.loaded ? shift(1 + gap / 2) : new THREE.Matrix4()).multiply(source.normalization);
     } else {
-      source.mesh.matrix.multiplyMatrices(this.frame.matrix, this.placement);
+      source.mesh.matrix.multiplyMatrices(this.frame.matrix, this.arrangement === 'exploded' ? this.exploded : this.placement);
     }
     target.mesh.visible = target.loaded && !this.showingResult;
     source.mesh.visible = source.loaded && !this.showingResult;
@@ -411,8 +443,45 @@ export class MergeView {
   // Frames the camera on what is shown, from the front and a little above.
   frameCamera() {
     if (!this.active) return;
-    const meshes = this.showingResult ? [this.result] : Object.values(this.sides).filter((s) => s.loaded).map((s) => s.mesh);
-    if (meshes.length) this.viewer.frameMeshes(meshes, { direction: [0, 0.3, 1] });
+    let meshes = this.showingResult ? [this.result] : Object.values(this.sides).filter((s) => s.loaded).map((s) => s.mesh);
+    const direction = this.arrangement !== 'apart' && this.viewDirection ? this.viewDirection : [0, 0.3, 1];
+    // Picking keys (exploded / placed): the seam region — the target around its chosen loop and
+    // the source — rather than the whole target.
+    const region = !this.showingResult && this.arrangement !== 'apart' ? this.loopRegion('target') : null;
+    if (region) meshes = [region, this.sides.source.mesh];
+    if (meshes.length) this.viewer.frameMeshes(meshes, { direction });
+  }
+
+  // A stand-in mesh (not in the scene) holding the points of a side's chosen loop and a band of
+  // the mesh around it (within two loop diameters of the loop's centre), placed like the side:
+  // what frameCamera fits when the seam matters more than the whole target.
+  loopRegion(name) {
+    const side = this.sides[name];
+    const loop = side.loops[side.chosenLoop];
+    if (!side.loaded || !loop) return null;
+    const centre = new THREE.Vector3();
+    for (const w of loop) centre.add(this.localPoint(name, w));
+    centre.divideScalar(loop.length);
+    let reach = 0;
+    for (const w of loop) reach = Math.max(reach, this.localPoint(name, w).distanceTo(centre));
+    reach *= 2.5;
+    const p = side.mesh.geometry.getAttribute('position');
+    const kept = [];
+    const v = new THREE.Vector3();
+    for (let i = 0; i < p.count; ++i) {
+      v.fromBufferAttribute(p, i);
+      if (v.distanceTo(centre) <= reach) kept.push(v.x, v.y, v.z);
+    }
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute('position', new THREE.Float32BufferAttribute(kept, 3));
+    geometry.computeBoundingBox();
+    const region = new THREE.Mesh(geometry);
+    this.root.updateMatrixWorld(true);
+    region.matrixAutoUpdate = false;
+    region.matrix.copy(side.mesh.matrixWorld);
+    region.matrixWorld.copy(side.mesh.matrixWorld);
+    region.matrixWorldNeedsUpdate = true; // updateMatrixWorld() copies matrix (no parent)
+    return region;
   }
 
   // Turns the camera about the orbit target so it looks at a side's chosen loop from outside
@@ -428,12 +497,21 @@ export class MergeView {
     this.root.updateMatrixWorld(true);
     const centre = centreLocal.clone().applyMatrix4(side.mesh.matrixWorld);
     const direction = outwardLocal.clone().transformDirection(side.mesh.matrixWorld).normalize();
-    // A little above the loop's axis, so the rim is seen as a ring, not edge-on.
-    const up = new THREE.Vector3(0, 1, 0);
-    const tilted = direction.clone().addScaledVector(up, 0.35).normalize();
-    const distance = camera.position.distanceTo(controls.target);
+    // From the side the camera looks from now, turned 50° towards the loop's axis: the rim is
+    // seen as an open ring, not edge-on, with the mesh around it; far enough to see it all.
+    const current = camera.position.clone().sub(controls.target).normalize();
+    let across = current.clone().addScaledVector(direction, -current.dot(direction));
+    if (across.lengthSq() < 1e-6) across = new THREE.Vector3(0, 1, 0).addScaledVector(direction, -direction.y);
+    across.normalize();
+    const angle = THREE.MathUtils.degToRad(50);
+    const tilted = across.multiplyScalar(Math.cos(angle)).addScaledVector(direction, Math.sin(angle)).normalize();
+    let length = 0;
+    loop.forEach((w, i) => { length += this.localPoint(name, w).distanceTo(this.localPoint(name, loop[(i + 1) % loop.length])); });
+    const worldScale = new THREE.Vector3().setFromMatrixScale(side.mesh.matrixWorld).x;
+    const loopRadius = (length / (2 * Math.PI)) * worldScale;
+    const distance = (loopRadius * 2.2) / Math.tan(THREE.MathUtils.degToRad(camera.fov) / 2);
     controls.target.copy(centre);
-    camera.position.copy(centre).addScaledVector(tilted, distance * 0.6);
+    camera.position.copy(centre).addScaledVector(tilted, distance);
     camera.lookAt(centre);
     controls.update();
     this.request();

@@ -25,7 +25,7 @@
 // cut plane {point, normal} in the mesh's coordinates or null.
 import * as THREE from 'three';
 import { MeshMorphError } from '../../lib/errors.js';
-import { bboxDiagonal, edgeDistances, planeRemoves, placeOnLoop, randomSimilarity } from '../../lib/merge-geometry.js';
+import { bboxDiagonal, edgeDistances, loopFrame, planeRemoves, placeOnLoop, randomSimilarity } from '../../lib/merge-geometry.js';
 import { KeyPairs, buildMergeSpec, keyPairsProblem, minKeys, readMergeSpec } from '../../lib/merge-spec.js';
 import { samples } from '../../lib/samples.js';
 import { vertexAdjacency } from '../../lib/vertex-sets.js';
@@ -81,6 +81,9 @@ const markup = `
     <label for="mg-source-loop">Source loop</label>
     <select id="mg-source-loop"></select>
     <button id="mg-source-look" type="button" title="Turn the camera to look into the source's chosen loop">Look</button>
+  </div>
+  <div class="row">
+    <button id="mg-frame" type="button" title="Frame the camera on the two boundaries (the whole result after a merge)">Frame the seam</button>
   </div>
   <details id="mg-cut" class="cut">
     <summary>Cut a mesh open…</summary>
@@ -363,10 +366,40 @@ export const panel = {
       changed();
     }
 
-    // Something the result depends on changed: the result goes.
+    // Something the result depends on changed: the result goes; the source is shown where the
+    // keys now put it.
     function changed() {
       if (result) clearResult();
+      arrange();
       refresh();
+    }
+
+    // The arrangement of the two meshes: dependent mode — the source where the person placed it;
+    // independent mode with both loops chosen — the source turned and scaled as it will attach
+    // (its first key on the target's first key), pulled out of the target's opening, seen from
+    // the side; otherwise side by side.
+    function arrange({ frame = false } = {}) {
+      const t = chosenLoop('target');
+      const s = chosenLoop('source');
+      let direction = null;
+      if (t) {
+        const { outward } = loopFrame(meshes.target.welded, t);
+        const look = [0.35, 0.25, 1];
+        const along = look[0] * outward[0] + look[1] * outward[1] + look[2] * outward[2];
+        direction = look.map((v, k) => v - along * outward[k] + 0.25 * outward[k]);
+      }
+      if (merge.mode === 'dependent' && t && s) {
+        view.setArrangement('placed', { viewDirection: direction, frame });
+      } else if (t && s) {
+        const m = placeOnLoop(meshes.target.welded, t, meshes.source.welded, s, keys.pairs[0] ?? null);
+        const { outward, length } = loopFrame(meshes.target.welded, t);
+        const gap = (1.3 * length) / (2 * Math.PI);
+        for (let k = 0; k < 3; ++k) m[12 + k] += gap * outward[k];
+        view.setExploded(m);
+        view.setArrangement('exploded', { viewDirection: direction, frame });
+      } else {
+        view.setArrangement('apart', { frame });
+      }
     }
 
     // ---- colours of the inputs: cut preview (red: removed) and fixed handles (blue)
@@ -436,8 +469,8 @@ export const panel = {
       if (disk?.side === side) disk = null;
       clearResult();
       showColors(side);
-      view.frameCamera();
       if (merge.mode === 'dependent' && side === 'source') placeSource();
+      arrange({ frame: true });
       app.setStatus(`${side}: ${info.name}${cuts.length ? `, cut ${cuts.length}×` : ''} — ${info.weldedVertices} vertices, ${info.faces} faces, ${info.loops.length} boundary loop(s) · cancel: ${client.cancelMode}`);
       refresh();
       return true;
@@ -479,6 +512,7 @@ export const panel = {
       });
       $(`mg-${side}-look`).addEventListener('click', () => lookAt(side));
     }
+    $('mg-frame').addEventListener('click', () => view.frameCamera());
     $('mg-example').addEventListener('click', async () => {
       if (await loadSample('target', mergeExample.target.sample, mergeExample.target.cuts)) {
         await loadSample('source', mergeExample.source.sample, mergeExample.source.cuts);
@@ -767,7 +801,6 @@ export const panel = {
       const first = keys.pairs[0] ?? null;
       merge.placement = placeOnLoop(meshes.target.welded, t, meshes.source.welded, s, first);
       view.setPlacement(merge.placement);
-      view.frameCamera();
       return true;
     }
     view.onPlacement = (elements) => {
@@ -782,15 +815,15 @@ export const panel = {
       if (mode === 'dependent') {
         // A first visit: start from the source put onto the target's loop.
         if (merge.placement.every((v, i) => v === identity[i])) placeSource();
-        view.setArrangement('placed');
         attachPlacementGizmo();
       } else {
         if (view.gizmoKind === 'place') view.detachGizmo();
         setBrush(false);
-        view.setArrangement('apart');
       }
       showColors('source');
-      changed();
+      if (result) clearResult();
+      arrange({ frame: true });
+      refresh();
     }
     for (const radio of root.querySelectorAll('input[name="mg-mode"]')) radio.addEventListener('change', () => setMode(radio.value));
     for (const radio of root.querySelectorAll('input[name="mg-place-mode"]')) {
@@ -798,13 +831,16 @@ export const panel = {
     }
     $('mg-place').addEventListener('click', () => {
       if (!placeSource()) app.showError({ code: 'InvalidArgument', message: 'choose the boundary loop of both meshes first (step 3)' });
-      changed();
+      if (result) clearResult();
+      arrange({ frame: true });
+      refresh();
     });
     $('mg-place-reset').addEventListener('click', () => {
       merge.placement = identity;
       view.setPlacement(identity);
-      view.frameCamera();
-      changed();
+      if (result) clearResult();
+      arrange({ frame: true });
+      refresh();
     });
 
     // ---- the spec
