@@ -329,11 +329,12 @@ export function registerMergeTests(it, { check, shot, nextFrame, waitIdle, canva
     check(m.target.loops.length === 0, 'the horse is not closed?');
     await page.click('#mg-cut summary');
     await page.check('input[name="mg-tool"][value="plane"]');
-    // Click the target near its middle (the view shows it on the left half).
+    // Click the target where the view shows its middle (a ray through the centre of its box).
     const box = await page.locator('#view').boundingBox();
+    const centre = await page.evaluate(() => window.__meshmorph.hooks.mergeCentreOnScreen('target'));
     let placed = null;
-    for (const [fx, fy] of [[0.27, 0.5], [0.3, 0.45], [0.25, 0.55], [0.33, 0.5], [0.2, 0.5]]) {
-      await page.mouse.move(box.x + box.width * fx, box.y + box.height * fy, { steps: 3 });
+    for (const [dx, dy] of [[0, 0], [0, 0.04], [0, -0.04], [0.03, 0], [-0.03, 0]]) {
+      await page.mouse.move(centre.x + box.width * dx, centre.y + box.height * dy, { steps: 3 });
       await page.mouse.down();
       await page.mouse.up();
       placed = await page.evaluate(() => window.__meshmorph.hooks.mergePlane());
@@ -354,8 +355,8 @@ export function registerMergeTests(it, { check, shot, nextFrame, waitIdle, canva
     await page.waitForFunction(() => window.__meshmorph.state.merge.target?.cuts.length === 0, null, { timeout: 60000 });
     await waitIdle(page);
     await page.check('input[name="mg-tool"][value="disk"]');
-    for (const [fx, fy] of [[0.27, 0.5], [0.3, 0.45], [0.25, 0.55], [0.33, 0.5]]) {
-      await page.mouse.move(box.x + box.width * fx, box.y + box.height * fy, { steps: 3 });
+    for (const [dx, dy] of [[0, 0], [0, 0.04], [0, -0.04], [0.03, 0]]) {
+      await page.mouse.move(centre.x + box.width * dx, centre.y + box.height * dy, { steps: 3 });
       await page.mouse.down();
       await page.mouse.up();
       if (await page.isEnabled('#mg-cut-apply')) break;

@@ -324,6 +324,16 @@ export class MergeView {
     };
   }
 
+  // Where the centre of a side's bounding box is on the screen: {x, y}.
+  centreOnScreen(name) {
+    const side = this.sides[name];
+    const rect = this.viewer.renderer.domElement.getBoundingClientRect();
+    this.viewer.camera.updateMatrixWorld();
+    this.root.updateMatrixWorld(true);
+    const ndc = side.center.clone().applyMatrix4(side.mesh.matrixWorld).project(this.viewer.camera);
+    return { x: rect.left + ((ndc.x + 1) / 2) * rect.width, y: rect.top + ((1 - ndc.y) / 2) * rect.height };
+  }
+
   showHover(pick) {
     this.hover.removeFromParent();
     if (!pick) {

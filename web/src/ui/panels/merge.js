@@ -1071,6 +1071,7 @@ export const panel = {
     app.hooks.mergeVertexOnScreen = (side, welded) => view.vertexOnScreen(side, welded);
     app.hooks.mergeResult = () => (result ? { positions: Array.from(result.positions), indices: Array.from(result.indices) } : null);
     app.hooks.mergePlane = () => (plane ? { side: plane.side, point: plane.point.toArray(), normal: plane.normal.toArray() } : null);
+    app.hooks.mergeCentreOnScreen = (side) => view.centreOnScreen(side);
     app.hooks.mergeLoops = () => ({ target: meshes.target?.info.loops ?? [], source: meshes.source?.info.loops ?? [] });
     app.hooks.mergeProblem = (pairs) => keyPairsProblem(pairs, chosenLoop('target'), chosenLoop('source'));
     // The source vertex furthest from its chosen loop's centre (a place for a fixed handle).
