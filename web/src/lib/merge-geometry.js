@@ -149,6 +149,24 @@ function rotationBetween(a, b) {
   return [0, 1, 2].map((i) => [0, 1, 2].map((j) => (i === j ? 1 : 0) + K[i][j] + K2[i][j] / (1 + c)));
 }
 
+// How to show a seam whose target opening faces `outward`: {right, up} (orthonormal, in the
+// meshes' coordinates) for a display turned so that the seam axis runs across the screen —
+// target on the left, source on the right — and "up" is the mesh's y or z axis, whichever is
+// further from the axis (so a z-up quadruped's neck is seen from the side, not from above).
+// null when the opening faces up or down (|outward·y| > 0.8): the page's usual y-up view
+// already shows that seam from the side.
+export function seamView(outward) {
+  const o = unit(outward);
+  if (Math.abs(o[1]) > 0.8) return null;
+  const right = o[0] < -1e-9 ? scale(o, -1) : o;
+  const candidates = [[0, 1, 0], [0, 0, 1]];
+  const axis = Math.abs(dot(candidates[0], o)) <= Math.abs(dot(candidates[1], o)) + 1e-9 ? candidates[0] : candidates[1];
+  let up = sub(axis, scale(right, dot(axis, right)));
+  if (norm(up) < 1e-6) return null;
+  up = unit(up);
+  return { right, up };
+}
+
 // Bounding-box diagonal of flat positions.
 export function bboxDiagonal(positions) {
   const lo = [Infinity, Infinity, Infinity];

@@ -146,12 +146,15 @@ export function keyPairsProblem(pairs, targetLoop, sourceLoop) {
   const ms = reversed.length;
   const s0 = spos[order[0]];
   let last = -1;
+  let previous = order[0];
   for (const i of order) {
     const rel = (spos[i] - s0 + ms) % ms;
     if (rel <= last) {
-      return `key pair ${i + 1} is out of order: going around the target loop, the source keys must follow the same way round their loop`;
+      const [a, b] = [previous, i].sort((x, y) => x - y);
+      return `key pairs ${a + 1} and ${b + 1} are out of order: going round the target loop, the source keys must come the same way round theirs (swap or delete one)`;
     }
     last = rel;
+    previous = i;
   }
   return null;
 }

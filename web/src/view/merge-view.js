@@ -428,6 +428,20 @@ export class MergeView {
     if (changed || frame) this.frameCamera();
   }
 
+  // Turns the whole merge scene for display: basis {right, up} (mesh coordinates) → screen x, y;
+  // null: as the meshes are.
+  setOrientation(basis) {
+    if (basis) {
+      const r = new THREE.Vector3(...basis.right);
+      const u = new THREE.Vector3(...basis.up);
+      const m = new THREE.Matrix4().makeBasis(r, u, r.clone().cross(u)).transpose();
+      this.root.quaternion.setFromRotationMatrix(m);
+    } else {
+      this.root.quaternion.identity();
+    }
+    this.root.updateMatrixWorld(true);
+  }
+
   setExploded(elements) {
     this.exploded.fromArray(elements);
     this.layout();

@@ -25,7 +25,7 @@
 // cut plane {point, normal} in the mesh's coordinates or null.
 import * as THREE from 'three';
 import { MeshMorphError } from '../../lib/errors.js';
-import { bboxDiagonal, edgeDistances, loopFrame, planeRemoves, placeOnLoop, randomSimilarity } from '../../lib/merge-geometry.js';
+import { bboxDiagonal, edgeDistances, loopFrame, planeRemoves, placeOnLoop, randomSimilarity, seamView } from '../../lib/merge-geometry.js';
 import { KeyPairs, buildMergeSpec, keyPairsProblem, minKeys, readMergeSpec } from '../../lib/merge-spec.js';
 import { samples } from '../../lib/samples.js';
 import { vertexAdjacency } from '../../lib/vertex-sets.js';
@@ -382,7 +382,13 @@ export const panel = {
       const t = chosenLoop('target');
       const s = chosenLoop('source');
       let direction = null;
-      if (t) {
+      const seamFrame = t && s ? seamView(loopFrame(meshes.target.welded, t).outward) : null;
+      view.setOrientation(seamFrame);
+      if (seamFrame) {
+        // The seam across the screen, seen a little from above and from the source's side,
+        // so the target's opening shows as a ring rather than edge-on.
+        direction = [0.55, 0.35, 1];
+      } else if (t) {
         const { outward } = loopFrame(meshes.target.welded, t);
         const look = [0.35, 0.25, 1];
         const along = look[0] * outward[0] + look[1] * outward[1] + look[2] * outward[2];
@@ -514,6 +520,11 @@ export const panel = {
     }
     $('mg-frame').addEventListener('click', () => view.frameCamera());
     $('mg-example').addEventListener('click', async () => {
+      const off = root.querySelector('input[name="mg-tool"][value=""]');
+      if (!off.checked) {
+        off.checked = true;
+        off.dispatchEvent(new Event('change'));
+      }
       if (await loadSample('target', mergeExample.target.sample, mergeExample.target.cuts)) {
         await loadSample('source', mergeExample.source.sample, mergeExample.source.cuts);
       }
