@@ -23,6 +23,7 @@ import { chromium } from 'playwright-core';
 import { build, preview } from 'vite';
 import { writeBigMesh } from './big-mesh.mjs';
 import { firefoxMissing, runInFirefox } from './firefox.mjs';
+import { registerMergeTests } from './merge.mjs';
 import { readPlyVertices } from './ply.mjs';
 
 const repoDir = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
@@ -1200,6 +1201,10 @@ it('recovery: a 1M-vertex mesh, a full wasm heap and a dead worker never take th
   check(pageErrors.length === 0, `uncaught page errors: ${pageErrors.join(' | ')}`);
   await page.close();
 });
+
+// ---- jobs with their own test files
+
+registerMergeTests(it, { check, shot, nextFrame, waitIdle, canvasPixels, pixelStats, repoDir, shotDir, cliPath });
 
 it('no console warnings or errors during the run', async ({ allConsole }) => {
   check(allConsole.length === 0, `${allConsole.length} console lines:\n${allConsole.slice(0, 20).join('\n')}`);

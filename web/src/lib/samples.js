@@ -12,6 +12,8 @@ export const samples = [
   { id: 'cat-07', label: 'Cat, pose 07 (PLY)', path: 'pose/cat-07.ply', credit: 'R. Sumner and J. Popović, Deformation Transfer (2004)', license: 'sumner-deftransfer-README.txt' },
   { id: 'lion', label: 'Lion, reference pose (PLY)', path: 'pose/lion-reference.ply', credit: 'R. Sumner and J. Popović, Deformation Transfer (2004)', license: 'sumner-deftransfer-README.txt' },
   { id: 'hand', label: 'Hand, low resolution (PLY)', path: 'edit/hand_lowres.ply', credit: 'Max Planck Society via SMPL, adapted by O. Stein', license: 'odedstein-hand-README.md' },
+  { id: 'horse', label: 'Horse (PLY, closed)', path: 'pose/horse0.ply', credit: 'TOSCA, Bronstein et al. (2008)' },
+  { id: 'camelhead', label: 'Camel head, open neck (PLY)', path: 'edit/camelhead.ply', credit: 'Camel head (data/MANIFEST.md)' },
 ];
 
 export const defaultSampleId = 'skull';

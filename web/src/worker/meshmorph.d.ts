@@ -145,3 +145,13 @@ export type Op = (ctx: OpContext, options: object, buffers: Buffers) => { buffer
 // ---- edit ops (ops/edit.js): positions results carry {positions, rawPositions, rawNormals}
 // ---- debug ops (ops/debug.js; the e2e recovery checks only)
 // debugExhaustMemory {} → {} / {allocatedMB};  debugCrash {} → the worker dies after answering
+// ---- merge ops (ops/merge.js; bindings wasm/bind_merge.cpp: mergeMeshes, cutMesh, boundaryLoops,
+//      exportAssetWithMesh in wasm/bind_mesh.cpp)
+// mergeOpen  {slot, name, cuts?: [{plane: [px,py,pz,nx,ny,nz], keep?} | {disk: [vertex, radius]}]}
+//            + buffers as for load → {positions, indices, normals?, toWelded, welded, weldedIndices}
+//            / {slot, name, format, rawVertices, weldedVertices, faces, loops: number[][], cuts, load}
+// merge      {targetSlot, sourceSlot, spec (the CLI's merge spec, object or JSON), placement?: 16}
+//            → {positions: Float64Array, indices, sourcePositions} / {vertices, faces,
+//              boundaryLoops, sourceOffset, stats, seams, milliseconds}
+// mergeExport {slot, format? = 'glb', placement?} + buffers {positions, indices}? (none: the
+//            slot's current mesh) → {bytes} / {fileName, format, byteLength}

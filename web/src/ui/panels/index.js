@@ -3,7 +3,8 @@
 import { panel as edit } from './edit.js';
 import { panel as eigen } from './eigen.js';
 import { panel as info } from './info.js';
+import { panel as merge } from './merge.js';
 import { panel as mesh } from './mesh.js';
 import { panel as transfer } from './transfer.js';
 
-export const panels = [mesh, eigen, info, edit, transfer];
+export const panels = [mesh, eigen, info, edit, transfer, merge];

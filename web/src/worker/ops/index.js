@@ -5,6 +5,7 @@
 import * as debug from './debug.js';
 import * as edit from './edit.js';
 import * as mesh from './mesh.js';
+import * as merge from './merge.js';
 import * as retarget from './retarget.js';
 import * as transfer from './transfer.js';
 
@@ -13,5 +14,6 @@ export const opFiles = {
   'edit.js': edit,
   'transfer.js': transfer,
   'retarget.js': retarget,
+  'merge.js': merge,
   'debug.js': debug,
 };
