@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <unordered_map>
 
@@ -80,8 +81,10 @@ TEST(HugeInputs, MillionVertexMeshIsLoadedReportedAndConverted) {
   EXPECT_EQ(back.asset.weld.V.rows(), m.V.rows());
   std::printf("[ HUGE ] %d vertices, %d faces: load %.2f s, info %.2f s, convert to GLB %.2f s\n",
               static_cast<int>(m.V.rows()), static_cast<int>(m.F.rows()), load_s, info_s, save_s);
-  std::remove(ply.c_str());
-  std::remove(glb.c_str());
+  if (!std::getenv("MM_KEEP_HUGE")) {  // set it to time `meshmorph info/convert` on the files by hand
+    std::remove(ply.c_str());
+    std::remove(glb.c_str());
+  }
 }
 
 // A sparse file of `bytes` bytes (nothing written, so no disk is used).
