@@ -1,6 +1,7 @@
 #include "app/edit_spec.h"
 
 #include <cmath>
+#include <cstdint>
 #include <set>
 
 #include <nlohmann/json.hpp>
@@ -30,7 +31,7 @@ struct EditSpecParser {
   }
   bool check_keys(const EditSpecJson& obj, const std::set<std::string>& allowed, const std::string& where) {
     for (auto it = obj.begin(); it != obj.end(); ++it)
-      if (!allowed.count(it.key())) return fail(StatusCode::ParseError, "unknown key \"" + it.key() + "\" in " + where);
+      if (!allowed.count(it.key())) return fail(StatusCode::ParseError, "unknown key \"" + io::quote_input(it.key(), 60) + "\" in " + where);
     return true;
   }
   bool number(const EditSpecJson& j, const std::string& where, double* out) {
@@ -41,6 +42,10 @@ struct EditSpecParser {
   }
   bool integer(const EditSpecJson& j, const std::string& where, int* out) {
     if (!j.is_number_integer()) return fail(StatusCode::ParseError, where + " must be an integer");
+    // get<int> of a larger value would wrap (4294967296 → vertex 0): out of range instead.
+    const bool fits = j.is_number_unsigned() ? j.get<uint64_t>() <= uint64_t{INT32_MAX}
+                                             : j.get<int64_t>() >= INT32_MIN && j.get<int64_t>() <= INT32_MAX;
+    if (!fits) return fail(StatusCode::InvalidArgument, where + " = " + j.dump() + " is out of range");
     *out = j.get<int>();
     return true;
   }

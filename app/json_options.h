@@ -8,6 +8,7 @@
 
 #include "app/option_schema.h"
 #include "common/status.h"
+#include "io/json_text.h"
 
 namespace mm::app {
 
@@ -24,7 +25,7 @@ Status set_options_from_json(const nlohmann::json& obj, const OptionSchema<O>& s
     else if (v.is_string()) value = OptionValue::of_text(v.get<std::string>());
     else
       return Status::error(StatusCode::ParseError,
-                           where + ": options." + it.key() + " must be a number, a string or true/false");
+                           where + ": options." + io::quote_input(it.key(), 60) + " must be a number, a string or true/false");
     const Status s = schema.set(*out, it.key(), value);
     if (!s.ok()) return Status::error(StatusCode::ParseError, where + ": " + s.message);
   }

@@ -328,10 +328,18 @@ LoadResult load_asset(const std::string& path, const LoadOptions& opt) {
   // URIs reach the resolver only after load_gltf's safety check (relative, no "..", no scheme),
   // so joining them to the file's folder cannot leave it.
   const std::string dir = detail::asset_parent_dir(path);
-  FileResolver resolver = [dir](const std::string& uri, std::vector<uint8_t>* out) {
-    return read_file(dir + uri, out).ok();
+  // The first refusal of a sibling file that exists (over kMaxInputBytes, not a regular file) is
+  // kept: the loader only learns "not there", and the user must hear why.
+  auto refused = std::make_shared<Status>();
+  FileResolver resolver = [dir, refused](const std::string& uri, std::vector<uint8_t>* out) {
+    Status s = read_file(dir + uri, out);
+    if (!s.ok() && refused->ok() && s.message.find("no such file") == std::string::npos) *refused = s;
+    return s.ok();
   };
-  return load_asset_from_memory(bytes, *format, path, resolver, opt);
+  r = load_asset_from_memory(bytes, *format, path, resolver, opt);
+  if (r.status.code == StatusCode::IoError && !refused->ok())
+    r.status = Status::error(refused->code, path + ": " + refused->message);
+  return r;
 }
 
 Status save_asset_to_memory(const Asset& asset, const Eigen::MatrixXd& V, Format format, std::vector<uint8_t>* bytes,

@@ -122,10 +122,13 @@ Status read_gltf_accessor(const tinygltf::Model& model, int index, Eigen::Matrix
                                                        " is smaller than the element size " + std::to_string(elem));
     p = accessor_view_data(model, a.bufferView, a.byteOffset, count, elem, stride, what, &status);
     if (!p) return status;
-  } else if (count > (uint64_t{1} << 26)) {
-    // Only sparse data backs an accessor without bufferView; 64M zero elements is not a mesh.
-    return Status::error(StatusCode::ParseError, what + " has no bufferView and an implausible count " +
-                                                     std::to_string(count));
+  } else if (count * static_cast<uint64_t>(nc) > (uint64_t{1} << 25)) {
+    // Only sparse data backs an accessor without bufferView: its size is whatever the JSON claims,
+    // so bound the zeros we allocate (2^25 values = 256 MiB of doubles; 11M VEC3 vertices). A
+    // 200-byte file asking for 2^26 MAT4 elements allocated 8 GiB before this.
+    return Status::error(StatusCode::ParseError, what + " has no bufferView and an implausible size (" +
+                                                     std::to_string(count) + " elements of " + std::to_string(nc) +
+                                                     " components; at most 33554432 values)");
   }
   out->setZero(static_cast<Eigen::Index>(count), nc);
   if (p)

@@ -30,7 +30,7 @@ JointSetResult parse_joints_json(const std::string& text) {
     for (size_t k = 0; ok && k < 3; ++k) ok = v[k].is_number() && std::isfinite(v[k].get<double>());
     if (!ok) {
       r.status = Status::error(StatusCode::ParseError,
-                               "joint '" + it.key() + "' must be an array of 3 finite numbers");
+                               "joint '" + quote_input(it.key(), 60) + "' must be an array of 3 finite numbers");
       return r;
     }
     r.joints.names.push_back(it.key());
@@ -51,7 +51,7 @@ JointMapResult parse_joint_map_json(const std::string& text) {
   }
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (!it.value().is_string()) {
-      r.status = Status::error(StatusCode::ParseError, "joint map entry '" + it.key() + "' must be a string");
+      r.status = Status::error(StatusCode::ParseError, "joint map entry '" + quote_input(it.key(), 60) + "' must be a string");
       return r;
     }
     r.source_to_target[it.key()] = it.value().get<std::string>();

@@ -26,7 +26,10 @@ Status check_json_depth(std::string_view text, const std::string& what, int max_
 
 std::string quote_input(std::string_view text, size_t max) {
   std::string out;
-  const size_t n = text.size() <= max ? text.size() : max;
+  size_t n = text.size() <= max ? text.size() : max;
+  // Do not cut inside a UTF-8 sequence (the page shows the message; a torn sequence shows as junk).
+  if (n < text.size())
+    while (n > 0 && (static_cast<unsigned char>(text[n]) & 0xC0) == 0x80) --n;
   out.reserve(n + 24);
   for (size_t i = 0; i < n; ++i) {
     const unsigned char c = static_cast<unsigned char>(text[i]);

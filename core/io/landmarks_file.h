@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "common/status.h"
@@ -12,5 +13,8 @@ namespace mm::io {
 
 // ParseError names the file and the first malformed pair; IoError when unreadable.
 Status read_landmarks(const std::string& path, std::vector<LandmarkPair>* pairs);
+
+// The same from the file's text (`name` is used in messages only). `pairs` is left empty on error.
+Status parse_landmarks(std::string_view text, const std::string& name, std::vector<LandmarkPair>* pairs);
 
 }  // namespace mm::io

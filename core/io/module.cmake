@@ -14,7 +14,8 @@ list(APPEND MM_IO_SOURCES
   core/io/gltf_save.cpp
   core/io/gltf_export.cpp
   core/io/tinygltf_impl.cpp)
-list(APPEND MM_TEST_SOURCES tests/io_test.cpp tests/io_gltf_test.cpp tests/io_hostile_test.cpp)
+list(APPEND MM_TEST_SOURCES tests/io_test.cpp tests/io_gltf_test.cpp tests/io_hostile_test.cpp
+  tests/io_fuzz_regressions_test.cpp tests/io_huge_test.cpp)
 list(APPEND MM_IO_SOURCES core/io/info_report.cpp)  # owned by the lead: the `info` report shared by CLI and wasm
 # glTF skins/animations (read into core/character types) and the morph-target animation writer.
 list(APPEND MM_IO_SOURCES core/io/gltf_animation.cpp core/io/gltf_animation_write.cpp core/io/joints_json.cpp)

@@ -93,7 +93,7 @@ Status load_off(const std::vector<uint8_t>& bytes, Asset* asset) {
     if (!parse_int_token(tok[0], &n) || n < 0)
       return error(StatusCode::ParseError, "face must start with its corner count");
     if (n < 3) return error(StatusCode::ParseError, "face has " + std::to_string(n) + " corners (at least 3 needed)");
-    if (static_cast<long long>(tok.size()) < n + 1)
+    if (n > static_cast<long long>(tok.size()) - 1)  // not n + 1: n may be LLONG_MAX
       return error(StatusCode::ParseError, "face declares " + std::to_string(n) + " corners but lists " +
                                                std::to_string(tok.size() - 1));
     std::vector<int> poly(static_cast<size_t>(n));

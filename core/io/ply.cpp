@@ -71,9 +71,34 @@ static double ply_decode(const uint8_t* p, PlyType t, bool big_endian) {
   return 0;
 }
 
+// The range of an integer PLY type.
+static void ply_integer_range(PlyType t, double* lo, double* hi) {
+  switch (t) {
+    case PlyType::Int8: *lo = INT8_MIN, *hi = INT8_MAX; return;
+    case PlyType::UInt8: *lo = 0, *hi = UINT8_MAX; return;
+    case PlyType::Int16: *lo = INT16_MIN, *hi = INT16_MAX; return;
+    case PlyType::UInt16: *lo = 0, *hi = UINT16_MAX; return;
+    case PlyType::Int32: *lo = INT32_MIN, *hi = INT32_MAX; return;
+    case PlyType::UInt32: *lo = 0, *hi = UINT32_MAX; return;
+    default: *lo = -HUGE_VAL, *hi = HUGE_VAL; return;
+  }
+}
+
+// A value written into an integer property: in the type's range (a cast of an out-of-range double
+// is undefined behaviour). Read values are range-checked already; this guards computed positions
+// written into integer x/y/z.
+static double ply_clamp_to_type(double value, PlyType t) {
+  if (!ply_is_integer_type(t)) return value;
+  if (std::isnan(value)) return 0;
+  double lo, hi;
+  ply_integer_range(t, &lo, &hi);
+  return std::min(hi, std::max(lo, value));
+}
+
 static void ply_encode(double value, PlyType t, bool big_endian, std::vector<uint8_t>* out) {
   uint8_t b[8];
   const size_t n = ply_type_size(t);
+  value = ply_clamp_to_type(value, t);
   switch (t) {
     case PlyType::Int8: { const int8_t v = static_cast<int8_t>(value); std::memcpy(b, &v, 1); break; }
     case PlyType::UInt8: { const uint8_t v = static_cast<uint8_t>(value); std::memcpy(b, &v, 1); break; }
@@ -88,7 +113,7 @@ static void ply_encode(double value, PlyType t, bool big_endian, std::vector<uin
 }
 
 static std::string ply_format_value(double value, PlyType t) {
-  if (ply_is_integer_type(t)) return std::to_string(static_cast<long long>(value));
+  if (ply_is_integer_type(t)) return std::to_string(static_cast<long long>(ply_clamp_to_type(value, t)));
   if (t == PlyType::Float64) return format_double(value);
   if (value == 0) return "0";  // folds -0, like format_double
   // Shortest text that reads back as the same float.
@@ -120,6 +145,16 @@ class PlyDataReader {
         bad_token_ = quote_input(tok);
         return false;
       }
+      // An integer property holds an integer of its type's range (binary data cannot do otherwise).
+      if (ply_is_integer_type(t)) {
+        double lo, hi;
+        ply_integer_range(t, &lo, &hi);
+        if (!(*v >= lo && *v <= hi && *v == std::floor(*v))) {
+          bad_token_ = quote_input(tok);
+          bad_kind_ = " is not an integer of the property's type";
+          return false;
+        }
+      }
       return true;
     }
     const size_t n = ply_type_size(t);
@@ -130,6 +165,7 @@ class PlyDataReader {
   }
   size_t remaining() const { return size_ - pos_; }
   const std::string& bad_token() const { return bad_token_; }
+  const std::string& bad_kind() const { return bad_kind_; }
 
  private:
   const uint8_t* data_;
@@ -137,6 +173,7 @@ class PlyDataReader {
   PlyEncoding enc_;
   size_t pos_ = 0;
   std::string bad_token_;
+  std::string bad_kind_ = " is not a number";
 };
 
 }  // namespace detail
@@ -221,7 +258,7 @@ Status load_ply(const std::vector<uint8_t>& bytes, Asset* asset) {
       for (PlyProperty& p : e.properties) {
         auto truncated = [&] {
           if (!data.bad_token().empty())
-            return fail(StatusCode::ParseError, "'" + data.bad_token() + "' is not a number (" + e.name + " " +
+            return fail(StatusCode::ParseError, "'" + data.bad_token() + "'" + data.bad_kind() + " (" + e.name + " " +
                                                     std::to_string(r) + ", property " + p.name + ")");
           return fail(StatusCode::ParseError, "PLY header declares " + std::to_string(e.count) + " " + e.name +
                                                   " elements but the data ends at " + e.name + " " +
