@@ -6,5 +6,16 @@ list(APPEND MM_CORE_SOURCES
   app/edit_spec.cpp
   app/edit_job.cpp
   app/retarget_job.cpp
-  app/merge_job.cpp)
-list(APPEND MM_TEST_SOURCES tests/app_test.cpp)
+  app/merge_job.cpp
+  app/batch_manifest.cpp
+  app/batch_state.cpp
+  app/batch_worker.cpp
+  app/batch_run.cpp)
+list(APPEND MM_TEST_SOURCES tests/app_test.cpp tests/batch_test.cpp)
+# Batch job keys include the program version (a new version re-runs every job).
+set_source_files_properties(app/batch_state.cpp PROPERTIES COMPILE_DEFINITIONS MM_PROGRAM_VERSION="${PROJECT_VERSION}")
+# `meshmorph batch` (native/commands/batch.cpp) is built by native/CMakeLists.txt's
+# commands/<module>.cpp rule: batch counts as a module of this tier there.
+if(NOT "batch" IN_LIST MM_MODULES)
+  list(APPEND MM_MODULES batch)
+endif()
