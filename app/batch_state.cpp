@@ -306,7 +306,7 @@ std::string batch_summary_table(const BatchSummary& s) {
     std::string what = o.status == "failed" || o.status == "not-run" ? o.message : metrics_text(o.metrics);
     if (o.reused) what += (what.empty() ? "" : "; ") + std::string("shared precompute");
     std::snprintf(line, sizeof line, "%-10s  %9s  %-*s  ", o.status == "failed" ? "FAILED" : o.status.c_str(),
-                  o.status == "not-run" ? "-" : duration_text(o.time_ms).c_str(), int(wide), o.id.c_str());
+                  o.status == "not-run" || o.status == "to-run" ? "-" : duration_text(o.time_ms).c_str(), int(wide), o.id.c_str());
     out += line + what + "\n";
   }
   std::snprintf(line, sizeof line, "%d job(s)%s: %d ok, %d up to date, %d failed, %d not run; wall %s with %d worker(s)\n",

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <cstdio>
 #include <cstdlib>
 #include <mutex>
@@ -11,6 +12,8 @@
 
 #include <cerrno>
 #endif
+
+#include <Eigen/Geometry>
 
 #include "app/edit_job.h"
 #include "app/json_options.h"
@@ -120,6 +123,49 @@ bool parse_batch_done_message(const Json& j, BatchJobOutcome* o) {
   return o->status == "ok" || o->status == "failed";
 }
 
+// ---- flipped faces
+
+FlipCounter::FlipCounter(const Eigen::MatrixXd& rest, const Eigen::MatrixXi& F) : F_(F), neighbours_(F.rows()) {
+  // As transfer_metrics: faces around each edge, edges in (min, max) order, so that the sums
+  // below add the same numbers in the same order.
+  std::map<std::pair<int, int>, std::vector<int>> edge_faces;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      edge_faces[{std::min(a, b), std::max(a, b)}].push_back(f);
+    }
+  for (const auto& [e, faces] : edge_faces)
+    for (int f : faces)
+      for (int g : faces)
+        if (f != g) neighbours_[static_cast<size_t>(f)].push_back(g);
+  const Eigen::VectorXd a = agreement(rest);
+  agrees_at_rest_.resize(static_cast<size_t>(F.rows()));
+  for (int f = 0; f < F.rows(); ++f) agrees_at_rest_[static_cast<size_t>(f)] = a[f] > 0.5;
+}
+
+Eigen::VectorXd FlipCounter::agreement(const Eigen::MatrixXd& V) const {
+  Eigen::MatrixXd N(F_.rows(), 3);
+  for (int f = 0; f < F_.rows(); ++f) {
+    const Eigen::Vector3d a = V.row(F_(f, 0)), b = V.row(F_(f, 1)), c = V.row(F_(f, 2));
+    N.row(f) = (b - a).cross(c - a).transpose();
+  }
+  Eigen::VectorXd out(F_.rows());
+  for (int f = 0; f < F_.rows(); ++f) {
+    Eigen::RowVector3d m = Eigen::RowVector3d::Zero();
+    for (int g : neighbours_[static_cast<size_t>(f)]) m += N.row(g);
+    const double l = N.row(f).norm() * m.norm();
+    out[f] = l > 0 ? N.row(f).dot(m) / l : 1.0;
+  }
+  return out;
+}
+
+int FlipCounter::count(const Eigen::MatrixXd& V) const {
+  const Eigen::VectorXd a = agreement(V);
+  int n = 0;
+  for (int f = 0; f < F_.rows(); ++f) n += a[f] < 0 && agrees_at_rest_[static_cast<size_t>(f)];
+  return n;
+}
+
 // ---- jobs
 
 struct BatchWorker::RetargetContext {
@@ -129,6 +175,7 @@ struct BatchWorker::RetargetContext {
   RetargetJobOptions opt;
   RetargetJob session;
   std::vector<std::string> warnings;
+  std::unique_ptr<FlipCounter> flips;  // on the target's rest surface
 };
 
 BatchWorker::~BatchWorker() = default;
@@ -187,6 +234,7 @@ std::shared_ptr<BatchWorker::RetargetContext> BatchWorker::retarget_context(cons
     prep.last_frame = -1;
     s = ctx->session.prepare(src.asset, ctx->target.asset, joints, map, prep, progress);
     ctx->warnings = ctx->session.warnings();
+    if (s.ok()) ctx->flips = std::make_unique<FlipCounter>(ctx->session.target_rest(), ctx->session.target_faces());
   }
   o->precompute_ms = ms_since(t0);
   if (reuse_) {
@@ -204,13 +252,12 @@ double height(const Eigen::MatrixXd& V) { return V.rows() ? V.col(1).maxCoeff() 
 // frame), the error against ground truth when the target has its own clip of that name (the
 // same character: self-retargeting, Eq. 19; a character with the same rig and clips), bone
 // lengths (harmonic).
-void retarget_metrics(const BatchJob& job, const RetargetJob& session, const std::string& clip_name,
+void retarget_metrics(const BatchJob& job, const RetargetJob& session, const FlipCounter& flips, const std::string& clip_name,
                       const std::vector<Eigen::MatrixXd>& frames, const std::vector<double>& times,
                       const std::vector<Eigen::MatrixXd>* joints, Json* m) {
   (*m)["frames"] = static_cast<int>(frames.size());
   int flipped = 0;
-  for (const Eigen::MatrixXd& V : frames)
-    flipped = std::max(flipped, transfer_metrics(V, session.target_rest(), session.target_faces()).flipped_faces);
+  for (const Eigen::MatrixXd& V : frames) flipped = std::max(flipped, flips.count(V));
   (*m)["flipped_faces_max"] = flipped;
   if (const AnimatedCharacter* tc = session.target_character()) {
     int clip = -1;
@@ -258,7 +305,8 @@ Status BatchWorker::run_retarget(const BatchJob& job, const Progress& progress, 
     if (Status s = session.frames(0, session.num_frames(), &frames, progress.sub(0.3, 0.9)); !s.ok()) return s;
     if (Status s = session.write_glb(frames, session.times(), &bytes); !s.ok()) return s;
     if (Status s = io::write_file_atomic(job.output, bytes); !s.ok()) return s;
-    retarget_metrics(job, session, session.clip_name(), frames, session.times(), nullptr, &o->metrics);
+    retarget_metrics(job, session, FlipCounter(session.target_rest(), session.target_faces()), session.clip_name(), frames,
+                     session.times(), nullptr, &o->metrics);
     return Status::success();
   }
 
@@ -298,7 +346,7 @@ Status BatchWorker::run_retarget(const BatchJob& job, const Progress& progress, 
     return s;
   if (Status s = io::write_file_atomic(job.output, bytes); !s.ok()) return s;
   progress.sub(0.9, 1).update("metrics", 0);
-  retarget_metrics(job, session, c.name, frames, times, &joints, &o->metrics);
+  retarget_metrics(job, session, *ctx->flips, c.name, frames, times, &joints, &o->metrics);
   return Status::success();
 }
 

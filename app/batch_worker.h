@@ -16,7 +16,9 @@
 #include <list>
 #include <memory>
 #include <string>
+#include <vector>
 
+#include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
 #include "app/batch_manifest.h"
@@ -28,6 +30,22 @@ namespace mm::app {
 // The line that hands `job` to a worker, and its inverse.
 std::string batch_job_message(const BatchJob& job);
 Status parse_batch_job_message(const std::string& line, BatchJob* job);
+
+// Flipped faces exactly as transfer_metrics counts them (a face whose normal opposes the
+// area-weighted mean normal of its edge neighbours in the pose, while agreeing with it by more
+// than 0.5 at rest), with the neighbours and the rest agreement computed once per target:
+// transfer_metrics rebuilds its edge map on every call, which cost ~10× the retargeting of a frame.
+class FlipCounter {
+ public:
+  FlipCounter(const Eigen::MatrixXd& rest, const Eigen::MatrixXi& F);
+  int count(const Eigen::MatrixXd& V) const;
+
+ private:
+  Eigen::VectorXd agreement(const Eigen::MatrixXd& V) const;
+  Eigen::MatrixXi F_;
+  std::vector<std::vector<int>> neighbours_;
+  std::vector<char> agrees_at_rest_;
+};
 
 class BatchWorker {
  public:

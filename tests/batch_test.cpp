@@ -13,6 +13,7 @@
 #include <sstream>
 #include <thread>
 
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #ifndef __EMSCRIPTEN__
@@ -29,6 +30,7 @@
 #include "app/retarget_job.h"
 #include "io/asset.h"
 #include "merge/cut.h"
+#include "metrics/transfer_metrics.h"
 #include "mesh/topology.h"
 #include "test_meshes.h"
 #include "test_support.h"
@@ -297,6 +299,22 @@ TEST(BatchWorker, SharedPrecomputationWritesTheSameBytesAsRetargetJob) {
   const std::string batch_bytes = read_text(dir + "/Walk.glb");
   EXPECT_EQ(batch_bytes.size(), bytes.size());
   EXPECT_TRUE(batch_bytes == std::string(bytes.begin(), bytes.end())) << "the worker's GLB differs from RetargetJob's";
+}
+
+TEST(BatchWorker, FlipCounterCountsAsTransferMetrics) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  test::icosphere(3, &V, &F);
+  const app::FlipCounter flips(V, F);
+  EXPECT_EQ(flips.count(V), 0);
+  // Rotated: nothing flips; two vertices of an edge swapped turn the faces around it over.
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(2.0, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  EXPECT_EQ(flips.count(V * R.transpose()), 0);
+  Eigen::MatrixXd W = V;
+  for (int f = 0; f < F.rows(); f += 97) W.row(F(f, 0)).swap(W.row(F(f, 1)));
+  const int n = flips.count(W);
+  EXPECT_GT(n, 10);
+  EXPECT_EQ(n, transfer_metrics(W, V, F).flipped_faces);
 }
 
 TEST(BatchWorker, JobMessagesRoundTrip) {
