@@ -38,12 +38,6 @@ namespace {
 
 double ms_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
 
-std::string seconds_text(double ms) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, ms < 10000 ? "%.2f s" : "%.0f s", ms / 1000);
-  return buf;
-}
-
 BatchJobOutcome outcome_of(const BatchJob& job) {
   BatchJobOutcome o;
   o.index = job.index;
@@ -77,6 +71,12 @@ void remove_stale_temporaries(const std::vector<const BatchJob*>& jobs) {
 #ifndef __EMSCRIPTEN__
 
 namespace {
+
+std::string seconds_text(double ms) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, ms < 10000 ? "%.2f s" : "%.0f s", ms / 1000);
+  return buf;
+}
 
 volatile std::sig_atomic_t g_interrupted = 0;
 void on_interrupt(int) { g_interrupted = 1; }

@@ -49,7 +49,7 @@ std::string read_text(const std::string& path) {
   return ss.str();
 }
 
-void write_text(const std::string& path, const std::string& text) {
+[[maybe_unused]] void write_text(const std::string& path, const std::string& text) {
   fs::create_directories(fs::path(path).parent_path());
   std::ofstream(path, std::ios::binary) << text;
 }
