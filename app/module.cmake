@@ -19,3 +19,9 @@ set_source_files_properties(app/batch_state.cpp PROPERTIES COMPILE_DEFINITIONS M
 if(NOT "batch" IN_LIST MM_MODULES)
   list(APPEND MM_MODULES batch)
 endif()
+# End to end on a private single-node Slurm (tests/batch_slurm.sh): skipped (77) unless slurm-wlm
+# and munge are installed and the tests run as root.
+if(NOT EMSCRIPTEN)
+  add_test(NAME batch_slurm COMMAND ${PROJECT_SOURCE_DIR}/tests/batch_slurm.sh $<TARGET_FILE:meshmorph>)
+  set_tests_properties(batch_slurm PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 600)
+endif()
