@@ -315,6 +315,7 @@ std::string batch_summary_table(const BatchSummary& s) {
                 s.count("ok"), s.count("up-to-date"), s.count("failed"), s.count("not-run"), duration_text(s.wall_ms).c_str(),
                 s.workers);
   out += line;
+  if (const int n = s.count("to-run"); n > 0) out += std::to_string(n) + " job(s) to run (--dry-run: nothing ran)\n";
   for (const std::string& w : s.warnings) out += "warning: " + w + "\n";
   return out;
 }
