@@ -98,17 +98,6 @@ void close_fd(int* fd) {
   *fd = -1;
 }
 
-bool write_all(int fd, const std::string& s) {
-  size_t done = 0;
-  while (done < s.size()) {
-    const ssize_t w = ::write(fd, s.data() + done, s.size() - done);
-    if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) return false;
-    done += static_cast<size_t>(w);
-  }
-  return true;
-}
-
 // Starts `exe batch --worker` with pipes on its stdin, stdout and stderr.
 Status spawn(Worker* w, const std::string& exe, bool reuse) {
   int pin[2], pout[2], perr[2];
@@ -437,7 +426,7 @@ BatchRunResult run_batch(const BatchManifest& m, const BatchRunOptions& opt, con
         w.job = j;
         w.fraction = 0;
         w.started = Clock::now();
-        if (!write_all(w.in, batch_job_message(m.jobs[static_cast<size_t>(j)]))) ::kill(w.pid, SIGKILL);  // reported at EOF
+        if (!write_fd_all(w.in, batch_job_message(m.jobs[static_cast<size_t>(j)]))) ::kill(w.pid, SIGKILL);  // reported at EOF
       }
       // Idle workers with nothing left to do: close their input, they exit.
       if (queue.size() == 0)

@@ -443,8 +443,7 @@ Status BatchWorker::run_merge(const BatchJob& job, const Progress& progress, Bat
 // ---- the worker process
 
 #ifndef __EMSCRIPTEN__
-namespace {
-bool write_all(int fd, const std::string& s) {
+bool write_fd_all(int fd, const std::string& s) {
   size_t done = 0;
   while (done < s.size()) {
     const ssize_t w = ::write(fd, s.data() + done, s.size() - done);
@@ -454,7 +453,6 @@ bool write_all(int fd, const std::string& s) {
   }
   return true;
 }
-}  // namespace
 
 int run_batch_worker_loop(int in_fd, int out_fd, bool reuse) {
   BatchWorker worker(reuse);
@@ -489,11 +487,11 @@ int run_batch_worker_loop(int in_fd, int out_fd, bool reuse) {
       last = now;
       char msg[96];
       std::snprintf(msg, sizeof msg, "{\"event\":\"progress\",\"index\":%d,\"f\":%.3f}\n", index, std::clamp(f, 0.0, 1.0));
-      write_all(out_fd, msg);
+      write_fd_all(out_fd, msg);
       return true;
     });
     o = worker.run(job, progress);
-    if (!write_all(out_fd, batch_done_message(o))) return 1;
+    if (!write_fd_all(out_fd, batch_done_message(o))) return 1;
   }
 }
 #else

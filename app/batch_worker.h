@@ -72,6 +72,9 @@ class BatchWorker {
 // Natively only (the wasm build returns 2).
 int run_batch_worker_loop(int in_fd, int out_fd, bool reuse);
 
+// Writes all of `s` to a pipe or file descriptor, retrying short writes and EINTR (native only).
+bool write_fd_all(int fd, const std::string& s);
+
 // The "done" line ↔ the outcome it carries.
 std::string batch_done_message(const BatchJobOutcome& o);
 bool parse_batch_done_message(const nlohmann::json& j, BatchJobOutcome* o);
