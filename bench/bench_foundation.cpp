@@ -70,7 +70,7 @@ void foundation_suite(Context& ctx) {
       SpectralBasis b;
       const double t = ctx.time_ms([&] { b = spectral_basis(W, a, opt); }, k == 20 ? 3 : 1);
       ctx.add({"foundation", name, n, "eigs k=" + std::to_string(k), t, k == 20 ? c.eigs20_peer : c.eigs100_peer,
-               b.status.ok() ? std::to_string(b.operations) + " solves" : b.status.message});
+               b.status.ok() ? std::to_string(b.operations) + " solves, " + std::to_string(b.passes) + (b.passes == 1 ? " pass" : " passes") : b.status.message});
     }
   }
 }

@@ -30,9 +30,13 @@ class ShiftInvertLdlt {
   Eigen::Index cols() const { return W_.cols(); }
 
   void set_shift(double sigma) {
+    if (factored_ && sigma == sigma_) return;  // a second guard pass reuses the factor
+    sigma_ = sigma;
+    factored_ = false;
     Eigen::SparseMatrix<double> M = W_ - sigma * A_;
     ldlt_.compute(M);
     if (ldlt_.info() != Eigen::Success) throw std::runtime_error("factorization of W - sigma A failed");
+    factored_ = true;
   }
 
   void perform_op(const double* x_in, double* y_out) const {
@@ -47,12 +51,32 @@ class ShiftInvertLdlt {
 
   int ops() const { return ops_; }
 
+  // The number of eigenvalues of W φ = λ A φ below tau: the negative pivots of LDLᵀ(W - τA)
+  // (Sylvester's law of inertia); the symbolic analysis is shared by every call. -1 if the
+  // factorization breaks down (an exact zero pivot).
+  int count_below(double tau) {
+    Eigen::SparseMatrix<double> M = W_ - tau * A_;
+    if (!sturm_analyzed_) {
+      sturm_.analyzePattern(M);
+      sturm_analyzed_ = true;
+    }
+    sturm_.factorize(M);
+    if (sturm_.info() != Eigen::Success) return -1;
+    const Eigen::VectorXd d = sturm_.vectorD();
+    if (!d.allFinite()) return -1;
+    return static_cast<int>((d.array() < 0).count());
+  }
+
  private:
   const Eigen::SparseMatrix<double>& W_;
   const Eigen::SparseMatrix<double>& A_;
   Progress progress_;
   int expected_ops_;
   mutable int ops_ = 0;
+  double sigma_ = 0;
+  bool factored_ = false;
+  bool sturm_analyzed_ = false;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> sturm_;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt_;
 };
 
@@ -76,13 +100,6 @@ SpectralBasis spectral_basis(const Eigen::SparseMatrix<double>& W, const Eigen::
                                      "clean the mesh first");
       return out;
     }
-  // Lanczos can miss copies of a multiple eigenvalue at the edge of the requested range (the
-  // unit sphere's 5-fold λ = 6 came back as 4 copies with k = 9). Guard eigenpairs beyond k
-  // make the first k complete; they cost ~10% more time and are dropped below.
-  const int nev = std::min(n - 1, opt.k + std::max(5, opt.k / 10));
-  const int ncv = opt.ncv > 0 ? std::min(n, std::max(opt.ncv, nev + 1))
-                              : std::min(n, std::max(2 * nev + 1, nev + 20));
-
   Eigen::SparseMatrix<double> A(n, n);
   {
     std::vector<Eigen::Triplet<double>> t;
@@ -91,31 +108,63 @@ SpectralBasis spectral_basis(const Eigen::SparseMatrix<double>& W, const Eigen::
   }
   const double sigma = -opt.relative_shift * W.diagonal().sum() / mass.sum();
 
-  ShiftInvertLdlt op(W, A, progress, 3 * ncv);
+  // Completeness by inertia instead of guard pairs. Lanczos can miss copies of a multiple
+  // eigenvalue, at the edge of the range and inside it (the icosphere's 5-fold λ ≈ 6 came back as
+  // 3 copies with nev = k = 11). Asking for k + max(5, k/10) pairs every time hid this on the
+  // cases seen, at 13–30 % of the solve (PEERS.md), and proved nothing. Now each pass asks for
+  // the pairs needed, then counts the eigenvalues below τ (just above λ_{k-1}) exactly: by
+  // Sylvester's law of inertia, the negative pivots of LDLᵀ(W - τA). If the count exceeds the
+  // computed values below τ, some were missed: the next pass asks for more.
+  ShiftInvertLdlt op(W, A, progress, 3 * std::min(n, std::max(2 * opt.k + 1, opt.k + 20)));
   Spectra::SparseSymMatProd<double> bop(A);
-  try {
-    Spectra::SymGEigsShiftSolver<ShiftInvertLdlt, Spectra::SparseSymMatProd<double>,
-                                 Spectra::GEigsMode::ShiftInvert>
-        solver(op, bop, nev, ncv, sigma);
-    solver.init();
-    solver.compute(Spectra::SortRule::LargestMagn, opt.max_iterations, opt.tolerance,
-                   Spectra::SortRule::SmallestAlge);
-    out.iterations = static_cast<int>(solver.num_iterations());
-    out.operations = op.ops();
-    if (solver.info() != Spectra::CompInfo::Successful) {
-      out.status = Status::error(StatusCode::NotConverged,
-                                 "eigensolver did not converge in " + std::to_string(opt.max_iterations) +
-                                     " restarts (k = " + std::to_string(opt.k) + ")");
+  const double tau_floor = std::abs(sigma);  // the scale at which λ₀ = 0 is told apart
+  int nev = opt.k;
+  Eigen::VectorXd sorted;
+  for (int pass = 0;; ++pass) {
+    const int ncv = opt.ncv > 0 ? std::min(n, std::max(opt.ncv, nev + 1))
+                                : std::min(n, std::max(2 * nev + 1, nev + 20));
+    try {
+      Spectra::SymGEigsShiftSolver<ShiftInvertLdlt, Spectra::SparseSymMatProd<double>,
+                                   Spectra::GEigsMode::ShiftInvert>
+          solver(op, bop, nev, ncv, sigma);
+      solver.init();
+      solver.compute(Spectra::SortRule::LargestMagn, opt.max_iterations, opt.tolerance,
+                     Spectra::SortRule::SmallestAlge);
+      out.iterations += static_cast<int>(solver.num_iterations());
+      if (solver.info() != Spectra::CompInfo::Successful) {
+        out.status = Status::error(StatusCode::NotConverged,
+                                   "eigensolver did not converge in " + std::to_string(opt.max_iterations) +
+                                       " restarts (k = " + std::to_string(opt.k) + ")");
+        return out;
+      }
+      out.eigenvalues = solver.eigenvalues();
+      out.vectors = solver.eigenvectors();
+    } catch (const CancelRequested&) {
+      out.status = cancelled_status("eigenbasis");
+      return out;
+    } catch (const std::exception& e) {
+      out.status = Status::error(StatusCode::FactorizationFailed, std::string("eigensolver: ") + e.what());
       return out;
     }
-    out.eigenvalues = solver.eigenvalues();
-    out.vectors = solver.eigenvectors();
-  } catch (const CancelRequested&) {
-    out.status = cancelled_status("eigenbasis");
-    return out;
-  } catch (const std::exception& e) {
-    out.status = Status::error(StatusCode::FactorizationFailed, std::string("eigensolver: ") + e.what());
-    return out;
+    out.passes = pass + 1;
+    out.operations = op.ops();
+    sorted = out.eigenvalues;
+    std::sort(sorted.data(), sorted.data() + sorted.size());
+    const double lam = sorted[opt.k - 1];
+    double tau = lam + std::max(opt.cluster_gap * std::abs(lam), tau_floor);
+    if (opt.k < sorted.size()) tau = std::min(tau, 0.5 * (lam + sorted[opt.k]));
+    const int computed = static_cast<int>(std::lower_bound(sorted.data(), sorted.data() + sorted.size(), tau) - sorted.data());
+    const int below = op.count_below(tau);
+    if (below < 0 || below <= computed) break;  // complete (or the count failed: keep the old guarantee)
+    if (pass >= 3 || nev >= n - 1) {
+      out.status = Status::error(StatusCode::NotConverged,
+                                 "eigensolver: " + std::to_string(below) + " eigenvalues lie below " +
+                                     std::to_string(tau) + " but Lanczos found " + std::to_string(computed) +
+                                     " after " + std::to_string(pass + 1) + " passes (k = " + std::to_string(opt.k) + ")");
+      return out;
+    }
+    out.missed += below - computed;
+    nev = std::min(n - 1, std::max(nev, below) + std::max(5, opt.k / 10));
   }
 
   // Ascending order (stable, so ties keep Spectra's deterministic order).

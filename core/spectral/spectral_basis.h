@@ -20,8 +20,10 @@ namespace mm {
 
 struct SpectralBasisOptions {
   int k = 20;                 // number of eigenpairs; 1 ≤ k < #V
-  int ncv = 0;                // Krylov subspace size; 0 = min(#V, max(2m + 1, m + 20)) with
-                              // m = k + max(5, k/10) (guard eigenpairs, see spectral_basis.cpp)
+  int ncv = 0;                // Krylov subspace size; 0 = min(#V, max(2m + 1, m + 20)) with m
+                              // the pairs asked for: k, more in a pass after missed eigenvalues
+  double cluster_gap = 1e-6;  // τ of the completeness count = λ_{k-1} (1 + cluster_gap), at least
+                              // |σ| above it (and below the next computed eigenvalue)
   double relative_shift = 1e-6; // σ = -relative_shift · tr(W)/tr(A): W - σA is SPD even though
                               // W is singular, and σ sits just below λ₀ = 0 for fast convergence
   double tolerance = 1e-10;   // Spectra's relative eigenvalue tolerance
@@ -34,6 +36,8 @@ struct SpectralBasis {
   Eigen::MatrixXd vectors;     // #V by k, A-orthonormal columns
   int iterations = 0;          // Spectra restarts used
   int operations = 0;          // shift-invert solves performed
+  int passes = 0;              // Lanczos runs: 1, or more when the inertia count found missed ones
+  int missed = 0;              // eigenvalues the earlier passes missed (copies in multiplets)
 };
 
 // W: #V by #V cotangent stiffness (PSD), mass: #V lumped areas (all > 0).
