@@ -81,37 +81,53 @@ Eigen::VectorXi vertex_components(const Eigen::MatrixXi& F, int n, int* count) {
 }
 
 std::vector<EdgeUse> edge_uses(const Eigen::MatrixXi& F) {
-  std::vector<std::pair<long long, int>> keys;
-  keys.reserve(F.rows() * 3);
-  for (int f = 0; f < F.rows(); ++f)
-    for (int c = 0; c < 3; ++c) {
-      int a = F(f, c), b = F(f, (c + 1) % 3);
-      if (a == b) continue;
-      if (a > b) std::swap(a, b);
-      keys.push_back({(static_cast<long long>(a) << 32) | static_cast<unsigned>(b), 0});
-    }
-  std::sort(keys.begin(), keys.end());
   std::vector<EdgeUse> out;
-  for (size_t k = 0; k < keys.size();) {
-    size_t e = k;
-    while (e < keys.size() && keys[e].first == keys[k].first) ++e;
-    out.push_back({static_cast<int>(keys[k].first >> 32),
-                   static_cast<int>(keys[k].first & 0xffffffffLL), static_cast<int>(e - k)});
-    k = e;
+  if (F.rows() == 0) return out;
+  const int n = F.maxCoeff() + 1;
+  const int halves = static_cast<int>(F.rows()) * 3;
+  auto ends = [&F](int h, int* lo, int* hi) {
+    const int f = h / 3, c = h % 3;
+    *lo = F(f, c);
+    *hi = F(f, (c + 1) % 3);
+    if (*lo > *hi) std::swap(*lo, *hi);
+  };
+  const VertexBuckets by_lo = bucket_by_vertex(n, halves, [&](int h) {
+    int lo, hi;
+    ends(h, &lo, &hi);
+    return lo == hi ? -1 : lo;
+  });
+  out.reserve(static_cast<size_t>(halves) / 2 + 1);
+  std::vector<int> his;
+  for (int v = 0; v < n; ++v) {
+    his.clear();
+    for (int k = by_lo.start[v]; k < by_lo.start[v + 1]; ++k) {
+      int lo, hi;
+      ends(by_lo.items[k], &lo, &hi);
+      his.push_back(hi);
+    }
+    std::sort(his.begin(), his.end());
+    for (size_t k = 0; k < his.size();) {
+      size_t e = k;
+      while (e < his.size() && his[e] == his[k]) ++e;
+      out.push_back({v, his[k], static_cast<int>(e - k)});
+      k = e;
+    }
   }
   return out;
 }
 
 std::vector<VertexFans> non_manifold_vertices(const Eigen::MatrixXi& F, int n, const std::vector<char>* only) {
-  std::vector<std::vector<int>> vf(n);
-  for (int f = 0; f < F.rows(); ++f)
-    for (int c = 0; c < 3; ++c)
-      if (!only || (*only)[F(f, c)]) vf[F(f, c)].push_back(f);
+  const VertexBuckets vf_corners = bucket_by_vertex(n, static_cast<int>(F.rows()) * 3, [&](int h) {
+    const int v = F(h / 3, h % 3);
+    return only && !(*only)[v] ? -1 : v;
+  });
+  std::vector<int> faces;
   std::vector<VertexFans> out;
   std::vector<int> parent;
   std::vector<std::pair<int, int>> spokes;
   for (int v = 0; v < n; ++v) {
-    const auto& faces = vf[v];
+    faces.clear();
+    for (int k = vf_corners.start[v]; k < vf_corners.start[v + 1]; ++k) faces.push_back(vf_corners.items[k] / 3);
     if (faces.size() < 2) continue;
     parent.resize(faces.size());
     std::iota(parent.begin(), parent.end(), 0);

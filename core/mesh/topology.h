@@ -40,7 +40,32 @@ Eigen::VectorXi vertex_components(const Eigen::MatrixXi& F, int n, int* count);
 // (non-manifold boundaries) end their chain where it cannot be continued.
 std::vector<std::vector<int>> boundary_loops(const Eigen::MatrixXi& F, int n);
 
-// Undirected edges (i < j) with the number of faces using each, sorted by (i, j).
+// Items 0..count-1 grouped by a vertex key in [0, n) by a counting sort (linear time): the items
+// of vertex v are items[start[v]] .. items[start[v + 1] - 1], in increasing item order. key(i)
+// returns the item's vertex, or -1 to leave it out.
+struct VertexBuckets {
+  std::vector<int> start;  // n + 1 offsets
+  std::vector<int> items;
+};
+template <class Key>
+VertexBuckets bucket_by_vertex(int n, int count, Key key) {
+  VertexBuckets b;
+  b.start.assign(static_cast<size_t>(n) + 1, 0);
+  std::vector<int> k(static_cast<size_t>(count));
+  for (int i = 0; i < count; ++i) {
+    k[i] = key(i);
+    if (k[i] >= 0) ++b.start[k[i] + 1];
+  }
+  for (int v = 0; v < n; ++v) b.start[v + 1] += b.start[v];
+  b.items.resize(b.start[n]);
+  std::vector<int> fill(b.start.begin(), b.start.end() - 1);
+  for (int i = 0; i < count; ++i)
+    if (k[i] >= 0) b.items[fill[k[i]]++] = i;
+  return b;
+}
+
+// Undirected edges (i < j) with the number of faces using each, sorted by (i, j). Linear time
+// (faces bucketed by the edge's smaller vertex); indices must be >= 0.
 struct EdgeUse {
   int i, j;    // endpoints, i < j
   int faces;   // number of faces containing this edge

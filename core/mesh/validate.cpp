@@ -168,20 +168,29 @@ MeshReport validate_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   for (int v = 0; v < n; ++v)
     if (!referenced[v]) unreferenced.add_lazy([&] { return "vertex " + std::to_string(v); });
 
-  // Duplicate faces: same sorted vertex triple.
+  // Duplicate faces: same sorted vertex triple (faces bucketed by their smallest vertex, then
+  // sorted within the bucket: linear overall).
   {
+    const VertexBuckets by_min = bucket_by_vertex(n, static_cast<int>(valid.size()), [&](int i) {
+      const int f = valid[i];
+      const int x = F(f, 0), y = F(f, 1), z = F(f, 2);
+      return (x == y || y == z || x == z) ? -1 : std::min(x, std::min(y, z));
+    });
     std::vector<std::pair<std::array<int, 3>, int>> keys;
-    keys.reserve(valid.size());
-    for (int f : valid) {
-      std::array<int, 3> k{F(f, 0), F(f, 1), F(f, 2)};
-      if (k[0] == k[1] || k[1] == k[2] || k[0] == k[2]) continue;
-      std::sort(k.begin(), k.end());
-      keys.push_back({k, f});
+    for (int v = 0; v < n; ++v) {
+      if (by_min.start[v + 1] - by_min.start[v] < 2) continue;
+      keys.clear();
+      for (int k = by_min.start[v]; k < by_min.start[v + 1]; ++k) {
+        const int f = valid[by_min.items[k]];
+        std::array<int, 3> t{F(f, 0), F(f, 1), F(f, 2)};
+        std::sort(t.begin(), t.end());
+        keys.push_back({t, f});
+      }
+      std::sort(keys.begin(), keys.end());
+      for (size_t i = 1; i < keys.size(); ++i)
+        if (keys[i].first == keys[i - 1].first)
+          duplicate.add(face_str(F, keys[i].second) + " repeats face " + std::to_string(keys[i - 1].second));
     }
-    std::sort(keys.begin(), keys.end());
-    for (size_t i = 1; i < keys.size(); ++i)
-      if (keys[i].first == keys[i - 1].first)
-        duplicate.add(face_str(F, keys[i].second) + " repeats face " + std::to_string(keys[i - 1].second));
   }
 
   // Topology over valid, non-repeating faces.
@@ -200,21 +209,25 @@ MeshReport validate_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                std::to_string(e.faces) + " faces";
       });
 
-  // Orientation: a directed edge used twice means two neighbours disagree on winding.
+  // Orientation: a directed edge used twice means two neighbours disagree on winding (half-edges
+  // bucketed by their first vertex).
   {
-    std::vector<long long> directed;
-    directed.reserve(rows * 3);
-    for (int f = 0; f < rows; ++f)
-      for (int c = 0; c < 3; ++c)
-        directed.push_back((static_cast<long long>(Fv(f, c)) << 32) |
-                           static_cast<unsigned>(Fv(f, (c + 1) % 3)));
-    std::sort(directed.begin(), directed.end());
-    for (size_t i = 1; i < directed.size(); ++i)
-      if (directed[i] == directed[i - 1] && (i < 2 || directed[i - 2] != directed[i]))
-        orientation.add_lazy([&] {
-          return "edge " + std::to_string(directed[i] >> 32) + "->" +
-                 std::to_string(directed[i] & 0xffffffffLL) + " appears twice";
-        });
+    const VertexBuckets by_from = bucket_by_vertex(n, rows * 3, [&](int h) { return Fv(h / 3, h % 3); });
+    std::vector<int> to;
+    for (int v = 0; v < n; ++v) {
+      if (by_from.start[v + 1] - by_from.start[v] < 2) continue;
+      to.clear();
+      for (int k = by_from.start[v]; k < by_from.start[v + 1]; ++k) {
+        const int h = by_from.items[k];
+        to.push_back(Fv(h / 3, (h % 3 + 1) % 3));
+      }
+      std::sort(to.begin(), to.end());
+      for (size_t i = 1; i < to.size(); ++i)
+        if (to[i] == to[i - 1] && (i < 2 || to[i - 2] != to[i]))
+          orientation.add_lazy([&] {
+            return "edge " + std::to_string(v) + "->" + std::to_string(to[i]) + " appears twice";
+          });
+    }
   }
 
   // Non-manifold vertices: the faces around a vertex must form one fan (mesh/topology.h).
