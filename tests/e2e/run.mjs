@@ -24,6 +24,7 @@ import { build, preview } from 'vite';
 import { writeBigMesh } from './big-mesh.mjs';
 import { firefoxMissing, runInFirefox } from './firefox.mjs';
 import { registerMergeTests } from './merge.mjs';
+import { registerRetargetTests } from './retarget.mjs';
 import { readPlyVertices } from './ply.mjs';
 
 const repoDir = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
@@ -1205,6 +1206,7 @@ it('recovery: a 1M-vertex mesh, a full wasm heap and a dead worker never take th
 // ---- jobs with their own test files
 
 registerMergeTests(it, { check, shot, nextFrame, waitIdle, canvasPixels, pixelStats, repoDir, shotDir, cliPath });
+registerRetargetTests(it, { check, shot, nextFrame, waitIdle, canvasPixels, pixelStats, repoDir, shotDir, cliPath, record });
 
 it('no console warnings or errors during the run', async ({ allConsole }) => {
   check(allConsole.length === 0, `${allConsole.length} console lines:\n${allConsole.slice(0, 20).join('\n')}`);

@@ -53,7 +53,7 @@ export class ClipPreview {
   }
 
   start() {
-    if (this.running) return;
+    if (this.running || !this.renderer) return;
     this.running = true;
     this.clock.start();
     const loop = () => {

@@ -137,10 +137,17 @@ async function fetchData(rel) {
 const fileName = (path) => path.slice(path.lastIndexOf('/') + 1);
 const stem = (name) => name.replace(/^.*[\\/]/, '').replace(/\.[^.]*$/, '');
 
+// three.js sanitizes node names ("upperarm.l" → "upperarml"); the core and the joints file use
+// the file's own names: the name of an object's glTF node.
+function nodeName(gltf, object) {
+  const index = gltf.parser.associations.get(object)?.nodes;
+  return index == null ? object.name : (gltf.parser.json.nodes[index].name ?? object.name);
+}
+
 // Joints of a skinned glTF in its scene's coordinates at the bind pose: every bone that moves
 // some skin (a weight > 0), at the translation of its inverse bind matrix's inverse.
 function skinJoints(gltf) {
-  const joints = new Map(); // name → {position, parent}
+  const joints = new Map(); // name → position
   gltf.scene.updateMatrixWorld(true);
   gltf.scene.traverse((o) => {
     if (!o.isSkinnedMesh) return;
@@ -154,18 +161,22 @@ function skinJoints(gltf) {
       }
     }
     skeleton.bones.forEach((bone, i) => {
-      if (!used.has(i) || joints.has(bone.name)) return;
+      const name = nodeName(gltf, bone);
+      if (!used.has(i) || joints.has(name)) return;
       const m = skeleton.boneInverses[i].clone().invert();
-      joints.set(bone.name, { position: new THREE.Vector3().setFromMatrixPosition(m).toArray() });
+      joints.set(name, new THREE.Vector3().setFromMatrixPosition(m).toArray());
     });
   });
-  return [...joints].map(([name, j]) => ({ name, position: j.position }));
+  return [...joints].map(([name, position]) => ({ name, position }));
 }
 
-// parentOf(name) over a glTF's node hierarchy.
+// parentOf(name) over a glTF's node hierarchy (the file's node names).
 function parentsOf(gltf) {
   const parents = new Map();
-  gltf.scene.traverse((o) => { if (o.name && o.parent) parents.set(o.name, o.parent.name || null); });
+  const nodes = gltf.parser.json.nodes || [];
+  nodes.forEach((node) => {
+    for (const c of node.children || []) if (nodes[c]?.name) parents.set(nodes[c].name, node.name ?? null);
+  });
   return (name) => parents.get(name) ?? null;
 }
 
