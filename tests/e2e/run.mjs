@@ -5,7 +5,7 @@
 // Screenshots (and the exported GLB) go to build/e2e/ or MM_E2E_OUT. Prints "N passed, M
 // failed"; exit code 1 on any failure.
 //
-// Then the page basics, the glTF materials, Edit and Transfer run again in Firefox ESR
+// Then the page basics, the glTF materials, Edit, Transfer and Retarget run again in Firefox ESR
 // (tests/e2e/firefox.mjs; skipped with a message when firefox-esr or Xvfb is missing).
 //
 // Usage: node tests/e2e/run.mjs [--headed] [--only <substring>] [--no-firefox | --firefox-only]
@@ -1215,7 +1215,7 @@ it('no console warnings or errors during the run', async ({ allConsole }) => {
 // ---- runner
 
 // The tests that also run in Firefox (by name prefix).
-const firefoxTests = ['page loads', 'the default sample mesh renders', 'glTF materials', 'edit: ', 'transfer: ', 'no console'];
+const firefoxTests = ['page loads', 'the default sample mesh renders', 'glTF materials', 'edit: ', 'transfer: ', 'retarget: ', 'no console'];
 
 // Installed in every page before its own scripts: the long-task observer (Chromium) and a
 // drop helper that dispatches dragenter / dragover / drop with a file at a fraction of the

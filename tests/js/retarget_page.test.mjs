@@ -112,6 +112,16 @@ test('joints: file round trip, errors, bones through missing ancestors, followin
   const restLengths = boneLengths(follower.at(rest), bones);
   assert.deepEqual(Array.from(restLengths), [3]);
   const change = boneLengthChange(at, bones, restLengths);
+  // Nearest vertices against a full sort (random cloud).
+  let seed = 7;
+  const random = () => { seed = (seed * 16807) % 2147483647; return seed / 2147483647; };
+  const cloud = Float32Array.from({ length: 3000 }, random);
+  const far = new JointFollower(cloud, [[0.5, 0.5, 0.5], [0, 1, 0]], 16);
+  for (const [j, p] of [[0.5, 0.5, 0.5], [0, 1, 0]].entries()) {
+    const d = (v) => (cloud[3 * v] - p[0]) ** 2 + (cloud[3 * v + 1] - p[1]) ** 2 + (cloud[3 * v + 2] - p[2]) ** 2;
+    const sorted = Array.from({ length: 1000 }, (_, v) => v).sort((a, b) => d(a) - d(b) || a - b).slice(0, 16);
+    assert.deepEqual(far.near[j], sorted);
+  }
   assert.ok(Math.abs(change.mean - 1 / 3) < 1e-6 && Math.abs(change.max - 1 / 3) < 1e-6);
 });
 

@@ -78,13 +78,23 @@ export class JointFollower {
   }
 }
 
+// The k nearest vertices (ties: lower index first), by insertion into a sorted list of k: O(#V·k).
 function nearestVertices(rest, p, k) {
   const n = rest.length / 3;
-  const d = new Float64Array(n);
-  for (let v = 0; v < n; ++v) d[v] = (rest[3 * v] - p[0]) ** 2 + (rest[3 * v + 1] - p[1]) ** 2 + (rest[3 * v + 2] - p[2]) ** 2;
-  const order = Array.from({ length: n }, (_, v) => v);
-  order.sort((a, b) => d[a] - d[b] || a - b);
-  return order.slice(0, k);
+  const best = [];   // vertex indices, nearest first
+  const dist = [];   // their squared distances
+  for (let v = 0; v < n; ++v) {
+    const d = (rest[3 * v] - p[0]) ** 2 + (rest[3 * v + 1] - p[1]) ** 2 + (rest[3 * v + 2] - p[2]) ** 2;
+    if (best.length === k && d >= dist[k - 1]) continue;
+    let i = best.length === k ? k - 1 : best.length;
+    while (i > 0 && dist[i - 1] > d) {
+      if (i < k) { best[i] = best[i - 1]; dist[i] = dist[i - 1]; }
+      i -= 1;
+    }
+    best[i] = v;
+    dist[i] = d;
+  }
+  return best;
 }
 
 const lengthOf = (p, a, b) => Math.hypot(p[3 * a] - p[3 * b], p[3 * a + 1] - p[3 * b + 1], p[3 * a + 2] - p[3 * b + 2]);

@@ -23,6 +23,9 @@ export class ClipPreview {
     this.running = false;
     this.frames = 0;
     this.clipName = null;
+    // While the main view plays the same clip the preview holds still (one WebGL context
+    // drawing per frame instead of two).
+    this.paused = false;
   }
 
   // gltf: the loaded character; index: the clip to play (null: the bind pose).
@@ -58,7 +61,7 @@ export class ClipPreview {
     this.clock.start();
     const loop = () => {
       if (!this.running) return;
-      if (!document.hidden && this.element.isConnected && this.element.offsetParent !== null) {
+      if (!this.paused && !document.hidden && this.element.isConnected && this.element.offsetParent !== null) {
         this.mixer?.update(Math.min(this.clock.getDelta(), 0.1));
         this.renderer.render(this.scene, this.camera);
         this.frames += 1;

@@ -369,6 +369,7 @@ export const panel = {
       retarget.source.clip = index;
       retarget.source.clipName = option;
       const clip = source.gltf.animations[index];
+      preview.paused = false;
       preview.show(source.gltf, index);
       $('rt-source-info').textContent = `${source.label || source.name} · ${clip.name || '(unnamed)'} · ${clip.duration.toFixed(2)} s`;
       // The main view shows the source in the clip's first pose until frames arrive.
@@ -716,6 +717,7 @@ export const panel = {
       if (follower && joints) view.moveJoints(follower.at(shownBuffer));
       retarget.frame = at.frame;
       retarget.shownFrames += 1;
+      preview.paused = retarget.playing;
       if (retarget.firstFrameMs == null && clipChosenAt != null) {
         retarget.firstFrameMs = Math.round(performance.now() - clipChosenAt);
         app.setStatus(`first retargeted frame shown ${(retarget.firstFrameMs / 1000).toFixed(2)} s after choosing the clip`);
