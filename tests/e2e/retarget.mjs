@@ -268,4 +268,26 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     await waitRun(page);
     check(pageErrors.length === 0, `uncaught page errors: ${pageErrors.join(' | ')}`);
   });
+  it('retarget: the person\'s own files — a skinned GLB as the source, a PLY target with its joints file', async ({ page, pageErrors }) => {
+    await openJob(page);
+    await page.setInputFiles('#rt-source-file', path.join(repoDir, 'data/anim/CesiumMan/CesiumMan.glb'));
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.source?.id === 'file', null, { timeout: 60000 });
+    await page.setInputFiles('#rt-target-file', path.join(repoDir, 'data/anim/human_woman.ply'));
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.target?.id === 'file', null, { timeout: 60000 });
+    await waitIdle(page);
+    const s0 = await rtState(page);
+    check(s0.jointsFrom === 'file' && s0.joints === 0, `own PLY target: joints ${s0.jointsFrom} ${s0.joints}`);
+    await page.setInputFiles('#rt-joints-file', path.join(repoDir, 'data/joints/human_woman_joints.json'));
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.joints === 19, null, { timeout: 30000 });
+    // CesiumMan's one clip has no name: it is listed as "(unnamed clip 1)".
+    const label = await page.textContent('#rt-clip option');
+    check(/unnamed clip 1/.test(label), `clip label ${label}`);
+    await page.selectOption('#rt-clip', '0');
+    const done = await waitRun(page);
+    check(done.run.frames > 10 && done.source.clipName === '', `CesiumMan run: ${JSON.stringify(done.run)}`);
+    await page.evaluate(() => window.__meshmorph.hooks.retargetSeek(1.0));
+    await nextFrame(page);
+    await shot(page, 'retarget-13-own-files');
+    check(pageErrors.length === 0, `uncaught page errors: ${pageErrors.join(' | ')}`);
+  });
 }

@@ -20,7 +20,7 @@ const markup = `
     </label>
   </div>
   <div class="timeline-plot-row" hidden>
-    <canvas id="rt-plot" class="timeline-plot" width="600" height="40"></canvas>
+    <div class="timeline-plot-box"><canvas id="rt-plot" class="timeline-plot" width="600" height="40"></canvas><div class="timeline-plot-cursor"></div></div>
     <span id="rt-plot-label" class="timeline-plot-label"></span>
   </div>
 </div>`;
@@ -38,6 +38,7 @@ export class Timeline {
     this.plot = q('rt-plot');
     this.plotLabel = q('rt-plot-label');
     this.plotRow = this.element.querySelector('.timeline-plot-row');
+    this.plotCursor = this.element.querySelector('.timeline-plot-cursor');
     this.playing = false;
     this.range = { start: 0, end: 1 };
     this.ranges = [];
@@ -120,6 +121,10 @@ export class Timeline {
     this.plotMax = max;
   }
 
-  // A cursor on the plot at the current frame.
-  markPlot() {}
+  // A cursor on the plot at frame `frame` of `count`, with the value in the label's tooltip.
+  markPlot(frame, count) {
+    this.plotCursor.hidden = !(count > 1 && frame >= 0);
+    if (this.plotCursor.hidden) return;
+    this.plotCursor.style.left = `${(100 * frame) / (count - 1)}%`;
+  }
 }

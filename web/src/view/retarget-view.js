@@ -241,9 +241,11 @@ export class RetargetView {
     mixer.setTime(0);
     this.played = { scene: gltf.scene, mixer, action, duration: clip?.duration ?? 0 };
     this.targetMesh.visible = false;
-    this.sides.target.root.add(gltf.scene);
+    // Measured in its own coordinates, before it hangs under the placed side.
     gltf.scene.updateMatrixWorld(true);
-    this.measure('target', new THREE.Box3().setFromObject(gltf.scene));
+    const box = new THREE.Box3().setFromObject(gltf.scene);
+    this.sides.target.root.add(gltf.scene);
+    this.measure('target', box);
   }
 
   setPlayedTime(t) {

@@ -100,6 +100,7 @@ const markup = `
     <progress id="rt-progress" max="1" value="0" hidden></progress>
     <span id="rt-run-text" class="hint"></span>
   </div>
+  <details id="rt-warnings" class="run-warnings" hidden><summary></summary><ul></ul></details>
   <div id="rt-options"></div>
 
   <h3>View</h3>
@@ -581,6 +582,15 @@ export const panel = {
       if (runner.stop()) runText(`Stopped (${why}).`);
     }
 
+    // The core's notes on the inputs (parts left out, joints not used), folded.
+    function showWarnings(list) {
+      const box = $('rt-warnings');
+      box.hidden = list.length === 0;
+      box.querySelector('summary').textContent = `${list.length} note${list.length === 1 ? '' : 's'} on the inputs`;
+      const ul = box.querySelector('ul');
+      ul.replaceChildren(...list.map((w) => Object.assign(document.createElement('li'), { textContent: w })));
+    }
+
     function clearRunDisplay() {
       store = null;
       surface = null;
@@ -630,8 +640,8 @@ export const panel = {
         retarget.frame = -1;
         retarget.shownFrames = 0;
         updateTimelineVisibility();
-        const warn = info.warnings?.length ? ` · ${info.warnings.join('; ')}` : '';
-        runText(`Prepared in ${(run.prepareMs / 1000).toFixed(2)} s (${info.frames} frames of ${info.clip || 'the clip'})${warn}`, 0);
+        showWarnings(info.warnings || []);
+        runText(`Prepared in ${(run.prepareMs / 1000).toFixed(2)} s (${info.frames} frames of ${info.clip || 'the clip'})`, 0);
         refresh();
         return;
       }
@@ -654,7 +664,7 @@ export const panel = {
       if (type === 'done') {
         run.status = 'done';
         run.framesMs = Math.round(performance.now() - run.preparedAt);
-        runText(`${store.count} frames: prepared in ${(run.prepareMs / 1000).toFixed(2)} s, frames in ${(run.framesMs / 1000).toFixed(2)} s (${(run.framesMs / store.count).toFixed(1)} ms each, with transfers)${run.warnings?.length ? ` · ${run.warnings.join('; ')}` : ''}`);
+        runText(`${store.count} frames: prepared in ${(run.prepareMs / 1000).toFixed(2)} s, frames in ${(run.framesMs / 1000).toFixed(2)} s (${(run.framesMs / store.count).toFixed(1)} ms each, with transfers)`);
         refresh();
         return;
       }
@@ -723,6 +733,7 @@ export const panel = {
         app.setStatus(`first retargeted frame shown ${(retarget.firstFrameMs / 1000).toFixed(2)} s after choosing the clip`);
       }
       timeline.setTime(t, at.frame);
+      if (plot) timeline.markPlot(at.frame, store.count);
       viewer.requestRender();
     }
 
