@@ -46,6 +46,14 @@ async function main() {
       window.__longTasks = [];
       new PerformanceObserver((list) => { for (const e of list.getEntries()) window.__longTasks.push({ start: e.startTime, duration: e.duration }); })
         .observe({ type: 'longtask', buffered: true });
+      // Which scripts made the slow frames (long-animation-frame, Chromium).
+      window.__longFrames = [];
+      new PerformanceObserver((list) => {
+        for (const e of list.getEntries()) {
+          window.__longFrames.push({ start: e.startTime, duration: e.duration, blocking: e.blockingDuration,
+            scripts: e.scripts.map((x) => `${x.invoker} ${x.sourceFunctionName || ''}:${x.sourceCharPosition} ${x.duration.toFixed(0)}ms`) });
+        }
+      }).observe({ type: 'long-animation-frame', buffered: true });
     });
     const page = context.pages()[0] || (await context.newPage());
     const { port } = server.httpServer.address();
@@ -80,6 +88,8 @@ async function main() {
     const load = `load average ${os.loadavg()[0].toFixed(1)} on ${os.cpus().length} cores`;
     console.log(`Knight Sit_Floor_Idle → human_woman (${vertices} vertices), ${state.run.frames} frames at ${fps} fps; clip chosen → first frame shown ${state.firstFrameMs} ms (prepare ${state.run.prepareMs} ms)`);
     console.log(`  while computing (${during.seconds.toFixed(1)} s, ${during.frames} frames arrived): ${during.fps.toFixed(1)} rendered frames/s, ${during.updates.toFixed(1)} target updates/s, longest main-thread task ${longDuring.toFixed(0)} ms`);
+    const slow = await page.evaluate(({ from, to }) => window.__longFrames.filter((f) => f.start >= from && f.start <= to).sort((a, b) => b.duration - a.duration).slice(0, 3), { from: first.t - 15000, to: done.t });
+    for (const f of slow) console.log(`  slow frame ${f.duration.toFixed(0)} ms (blocking ${f.blocking.toFixed(0)} ms): ${f.scripts.join(' | ') || 'no script (rendering / the GPU process)'}`);
     console.log(`  after the last frame (${after.seconds.toFixed(1)} s): ${after.fps.toFixed(1)} rendered frames/s, ${after.updates.toFixed(1)} target updates/s, longest main-thread task ${longAfter.toFixed(0)} ms (${load})`);
   } finally {
     await context.close();
