@@ -19,7 +19,7 @@ export class ClipPreview {
     this.camera = new THREE.PerspectiveCamera(35, width / height, 0.01, 100);
     this.model = null;
     this.mixer = null;
-    this.clock = new THREE.Clock(false);
+    this.last = 0; // performance.now() of the last drawn frame
     this.running = false;
     this.frames = 0;
     this.clipName = null;
@@ -58,15 +58,15 @@ export class ClipPreview {
   start() {
     if (this.running || !this.renderer) return;
     this.running = true;
-    this.clock.start();
-    const loop = () => {
+    this.last = performance.now();
+    const loop = (now) => {
       if (!this.running) return;
+      const dt = Math.min(Math.max(0, (now - this.last) / 1000), 0.1);
+      this.last = now;
       if (!this.paused && !document.hidden && this.element.isConnected && this.element.offsetParent !== null) {
-        this.mixer?.update(Math.min(this.clock.getDelta(), 0.1));
+        this.mixer?.update(dt);
         this.renderer.render(this.scene, this.camera);
         this.frames += 1;
-      } else {
-        this.clock.getDelta();
       }
       requestAnimationFrame(loop);
     };
@@ -75,6 +75,5 @@ export class ClipPreview {
 
   stop() {
     this.running = false;
-    this.clock.stop();
   }
 }

@@ -305,8 +305,11 @@ export const panel = {
       s.gltf.scene.traverse((o) => { if (o.isSkinnedMesh) skinned.push(o); });
       if (!skinned.length) throw new MeshMorphError('InvalidArgument', `${s.name} has no skin (no skinned mesh): the source must be a rigged, animated character`);
       if (!s.gltf.animations.length) throw new MeshMorphError('InvalidArgument', `${s.name} has no animation clips`);
-      source = { ...s, parentOf: parentsOf(s.gltf) };
-      retarget.source = { id: s.id, name: s.name, family: s.family, clips: s.gltf.animations.map((c) => c.name), clip: null, clipName: null };
+      // The file's own clip names ("" when unnamed; three.js would say "animation_0").
+      const names = (s.gltf.parser.json.animations || []).map((a) => a.name ?? '');
+      const clips = s.gltf.animations.map((c, i) => ({ name: names[i] ?? c.name, duration: c.duration }));
+      source = { ...s, clips, parentOf: parentsOf(s.gltf) };
+      retarget.source = { id: s.id, name: s.name, family: s.family, clips: clips.map((c) => c.name), clip: null, clipName: null };
       $('rt-clip-filter').value = '';
       showClips();
       $('rt-source-info').textContent = `${s.label || s.name}: ${s.gltf.animations.length} clip${s.gltf.animations.length === 1 ? '' : 's'}. Pick one.`;
@@ -320,7 +323,7 @@ export const panel = {
       const select = $('rt-clip');
       select.replaceChildren();
       if (!source) return;
-      const list = filterClips(source.gltf.animations, $('rt-clip-filter').value);
+      const list = filterClips(source.clips, $('rt-clip-filter').value);
       for (const c of list) {
         const o = new Option(`${c.label}  (${c.duration.toFixed(1)} s)`, String(c.index));
         select.add(o);
@@ -360,7 +363,7 @@ export const panel = {
 
     function chooseClip(index) {
       if (!source) return;
-      const option = clipOption(source.gltf.animations, index);
+      const option = clipOption(source.clips, index);
       if (option == null) {
         app.showError({ code: 'InvalidArgument', message: 'this clip has no name, and only the first clip of a file can be chosen without one' });
         return;
@@ -372,7 +375,7 @@ export const panel = {
       const clip = source.gltf.animations[index];
       preview.paused = false;
       preview.show(source.gltf, index);
-      $('rt-source-info').textContent = `${source.label || source.name} · ${clip.name || '(unnamed)'} · ${clip.duration.toFixed(2)} s`;
+      $('rt-source-info').textContent = `${source.label || source.name} · ${source.clips[index].name || '(unnamed)'} · ${clip.duration.toFixed(2)} s`;
       // The main view shows the source in the clip's first pose until frames arrive.
       view.setSource(source.gltf, index);
       view.setSourceTime(0);
