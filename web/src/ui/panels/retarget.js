@@ -112,7 +112,7 @@ const markup = `
 
   <h3>Export</h3>
   <div class="row">
-    <button id="rt-export" type="button" data-idle title="The target with one morph target per frame and their animation (plays in three.js and Blender)">Download GLB</button>
+    <button id="rt-export" type="button" title="The target with one morph target per frame and their animation (plays in three.js and Blender)">Download GLB</button>
     <button id="rt-joints-save" type="button" title="The target's joints as the CLI's joints file">Download joints JSON</button>
   </div>
   <div class="row">
@@ -232,6 +232,8 @@ export const panel = {
     let form = null;
     let visible = false;
     let clipChosenAt = null; // performance.now() when the clip was chosen (first frame timing)
+    let timedStore = null;   // the first run's frames after that choice (older frames do not count)
+    let timingPending = false;
     let userPaused = false;
     const clock = new PlaybackClock();
 
@@ -269,7 +271,7 @@ export const panel = {
       steps.set(step, next);
       $('rt-stop').disabled = !(run.status === 'preparing' || run.status === 'frames');
       $('rt-run').disabled = !(source && target && joints);
-      $('rt-export').disabled = !(store && store.complete) || app.state.busy != null;
+      $('rt-export').disabled = !(store && store.complete);
       $('rt-joints-save').disabled = !joints;
       $('rt-joints-file-label').classList.toggle('disabled', retarget.jointsFrom !== 'file');
       $('rt-joints-file').disabled = retarget.jointsFrom !== 'file';
@@ -370,6 +372,8 @@ export const panel = {
       }
       clipChosenAt = performance.now();
       retarget.firstFrameMs = null;
+      timingPending = true;
+      timedStore = null;
       retarget.source.clip = index;
       retarget.source.clipName = option;
       const clip = source.gltf.animations[index];
@@ -628,6 +632,10 @@ export const panel = {
         clearPlayedGlb();
         surface = { positions: buffers.targetPositions, indices: buffers.targetIndices };
         store = new FrameStore(buffers.times, buffers.targetPositions.length / 3);
+        if (timingPending) {
+          timedStore = store;
+          timingPending = false;
+        }
         view.setTargetMesh(surface);
         shownBuffer = new Float32Array(buffers.targetPositions.length);
         follower = joints ? new JointFollower(surface.positions, joints.positions) : null;
@@ -731,7 +739,7 @@ export const panel = {
       retarget.frame = at.frame;
       retarget.shownFrames += 1;
       preview.paused = retarget.playing;
-      if (retarget.firstFrameMs == null && clipChosenAt != null) {
+      if (retarget.firstFrameMs == null && clipChosenAt != null && store === timedStore) {
         retarget.firstFrameMs = Math.round(performance.now() - clipChosenAt);
         app.setStatus(`first retargeted frame shown ${(retarget.firstFrameMs / 1000).toFixed(2)} s after choosing the clip`);
       }
