@@ -451,7 +451,8 @@ export const panel = {
               text = new TextDecoder().decode(await fetchData(rel));
               name = fileName(rel);
             } else if (entry.joints) {
-              $('rt-target-info').textContent = `${target.name} has joints placed for the ${familiesOf(entry).join(', ')} skeleton${familiesOf(entry).length > 1 ? 's' : ''}${source ? `, not for ${source.label || source.name}` : ''}: pick such a clip, or load a joints file with this skeleton's names.`;
+              const fits = librarySources.filter((x) => familiesOf(entry).includes(x.family)).map((x) => x.label).join(', ');
+              $('rt-target-info').textContent = `${target.name} has joints placed for the skeletons of ${fits}${source ? `, not for ${source.label || source.name}` : ''}: pick a clip of one of those, or load a joints file with this skeleton's names.`;
               return refresh();
             }
           } else if (retarget.userJoints) {
