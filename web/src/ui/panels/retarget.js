@@ -260,7 +260,7 @@ export const panel = {
       } else if (run.status === 'error' || run.status === 'idle' || run.status === 'stopped') {
         step = 2;
         next = run.status === 'error' ? 'Fix the problem above (or change an option), then press Retarget.' : 'Press Retarget.';
-      } else if (!retarget.exports) {
+      } else if (retarget.exportedRun !== retarget.runs) {
         step = 3;
         next = 'Play, scrub, change the speed; toggle harmonic / LBS to compare. Then Download GLB.';
       } else {
@@ -803,6 +803,7 @@ export const panel = {
       const name = `${stem(target.name)}-${stem(retarget.source.clipName || 'clip')}${retarget.method === 'lbs' ? '-lbs' : ''}.glb`;
       download(exported.buffers.bytes, name, 'model/gltf-binary');
       retarget.exports += 1;
+      retarget.exportedRun = retarget.runs;
       $('rt-export-info').textContent = `${name}: ${(exported.buffers.bytes.length / 1e6).toFixed(2)} MB, ${store.count} morph targets.`;
       refresh();
     });
