@@ -3,7 +3,8 @@
 // - The wasm module is imported from the CMake build (`@meshmorph/wasm/meshmorph_web.mjs`,
 //   default build/wasm/wasm, override with MM_WASM_DIR). Its glue locates the .wasm with
 //   `new URL('meshmorph_web.wasm', import.meta.url)`, which Vite turns into a hashed asset.
-// - Gallery samples (web/src/lib/samples.js) are served from data/ by the dev server and copied
+// - Gallery samples (web/src/lib/samples.js) and the Retarget job's characters and joints files
+//   (web/src/lib/clip-library.js) are served from data/ by the dev server and copied
 //   into the build under samples/, with data/licenses/.
 // - COOP/COEP headers make the page crossOriginIsolated, so SharedArrayBuffer exists and
 //   Cancel can stop a computation without killing the worker (see web/src/lib/client.js).
@@ -11,6 +12,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { defineConfig } from 'vite';
+import { libraryFiles } from './src/lib/clip-library.js';
 import { sampleFiles } from './src/lib/samples.js';
 
 const webDir = path.dirname(fileURLToPath(import.meta.url));
@@ -26,7 +28,7 @@ const isolationHeaders = {
 const contentTypes = {
   '.glb': 'model/gltf-binary', '.gltf': 'model/gltf+json', '.bin': 'application/octet-stream',
   '.png': 'image/png', '.jpg': 'image/jpeg', '.ply': 'application/octet-stream',
-  '.obj': 'text/plain', '.off': 'text/plain', '.md': 'text/plain; charset=utf-8', '.txt': 'text/plain; charset=utf-8',
+  '.obj': 'text/plain', '.off': 'text/plain', '.md': 'text/plain; charset=utf-8', '.json': 'application/json', '.txt': 'text/plain; charset=utf-8',
 };
 
 function licenseFiles() {
@@ -35,7 +37,7 @@ function licenseFiles() {
 
 // Only listed files are reachable (no path traversal into the repository).
 function meshmorphSamples() {
-  const allowed = () => new Set([...sampleFiles(), ...licenseFiles()]);
+  const allowed = () => new Set([...sampleFiles(), ...libraryFiles(), ...licenseFiles()]);
   return {
     name: 'meshmorph-samples',
     configureServer(server) {

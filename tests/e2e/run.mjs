@@ -5,7 +5,7 @@
 // Screenshots (and the exported GLB) go to build/e2e/ or MM_E2E_OUT. Prints "N passed, M
 // failed"; exit code 1 on any failure.
 //
-// Then the page basics, the glTF materials, Edit and Transfer run again in Firefox ESR
+// Then the page basics, the glTF materials, Edit, Transfer and Retarget run again in Firefox ESR
 // (tests/e2e/firefox.mjs; skipped with a message when firefox-esr or Xvfb is missing).
 //
 // Usage: node tests/e2e/run.mjs [--headed] [--only <substring>] [--no-firefox | --firefox-only]
@@ -24,6 +24,7 @@ import { build, preview } from 'vite';
 import { writeBigMesh } from './big-mesh.mjs';
 import { firefoxMissing, runInFirefox } from './firefox.mjs';
 import { registerMergeTests } from './merge.mjs';
+import { registerRetargetTests } from './retarget.mjs';
 import { readPlyVertices } from './ply.mjs';
 
 const repoDir = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
@@ -586,7 +587,8 @@ it('edit: brush two handles and a fixed part, drag the gizmo, finalize; the save
   const otherHand = await visibleVertex(page, '-x');
   check(otherHand, 'no visible vertex on the left of the mesh');
   await page.mouse.move(otherHand.x, otherHand.y, { steps: 3 });
-  check(await page.isVisible('.brush-cursor:not([hidden])'), 'no brush cursor over the mesh');
+  // The Merge job has a brush cursor of its own (hidden here): look for the one that shows.
+  check(await page.evaluate(() => [...document.querySelectorAll('.brush-cursor')].some((e) => !e.hidden && e.getBoundingClientRect().width > 0)), 'no brush cursor over the mesh');
   await shot(page, '11-edit-1-brush');
   await stroke(page, otherHand);
   await page.click('#edit-grow');
@@ -1205,6 +1207,7 @@ it('recovery: a 1M-vertex mesh, a full wasm heap and a dead worker never take th
 // ---- jobs with their own test files
 
 registerMergeTests(it, { check, shot, nextFrame, waitIdle, canvasPixels, pixelStats, repoDir, shotDir, cliPath });
+registerRetargetTests(it, { check, shot, nextFrame, waitIdle, canvasPixels, pixelStats, repoDir, shotDir, cliPath, record });
 
 it('no console warnings or errors during the run', async ({ allConsole }) => {
   check(allConsole.length === 0, `${allConsole.length} console lines:\n${allConsole.slice(0, 20).join('\n')}`);
@@ -1213,7 +1216,7 @@ it('no console warnings or errors during the run', async ({ allConsole }) => {
 // ---- runner
 
 // The tests that also run in Firefox (by name prefix).
-const firefoxTests = ['page loads', 'the default sample mesh renders', 'glTF materials', 'edit: ', 'transfer: ', 'no console'];
+const firefoxTests = ['page loads', 'the default sample mesh renders', 'glTF materials', 'edit: ', 'transfer: ', 'retarget: ', 'no console'];
 
 // Installed in every page before its own scripts: the long-task observer (Chromium) and a
 // drop helper that dispatches dragenter / dragover / drop with a file at a fraction of the

@@ -155,3 +155,14 @@ export type Op = (ctx: OpContext, options: object, buffers: Buffers) => { buffer
 //              boundaryLoops, sourceOffset, stats, seams, milliseconds}
 // mergeExport {slot, format? = 'glb', placement?} + buffers {positions, indices}? (none: the
 //            slot's current mesh) → {bytes} / {fileName, format, byteLength}
+// ---- retarget ops (ops/retarget.js; bindings wasm/bind_retarget.cpp; the page's caller is
+//      lib/retarget-runner.js)
+// retargetPrepare {sourceName, targetName, targetJointsJson? ('' = the target's skin),
+//            jointMapJson?, ...options of optionSchema {job: 'retarget'}} + buffers {source,
+//            target: bytes} → {times: Float64Array, targetPositions: Float32Array (#V·3 rest),
+//            targetIndices} / {session, frames, clip, warnings: string[]}
+// retargetFrames {session, first = 0, count = rest} → {positions: Float32Array (count·#V·3,
+//            frame-major)} / {first, count}; progress stage 'frames', cancellable
+// retargetExportGlb {session} + buffers {positions (all frames so far, frame-major)}
+//            → {bytes} (the target with one morph target per frame) / {}
+// retargetDispose {session} → {} / {disposed}

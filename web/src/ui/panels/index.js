@@ -5,6 +5,7 @@ import { panel as eigen } from './eigen.js';
 import { panel as info } from './info.js';
 import { panel as merge } from './merge.js';
 import { panel as mesh } from './mesh.js';
+import { panel as retarget } from './retarget.js';
 import { panel as transfer } from './transfer.js';
 
-export const panels = [mesh, eigen, info, edit, transfer, merge];
+export const panels = [mesh, eigen, info, edit, transfer, merge, retarget];

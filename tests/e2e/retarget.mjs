@@ -1,0 +1,293 @@
+// End-to-end tests of the Retarget job (web/src/ui/panels/retarget.js), registered by
+// tests/e2e/run.mjs (`registerRetargetTests(it, helpers)`): a KayKit clip from the page's clip
+// library (with its preview) onto the rigged Barbarian (joints from its skin) and onto the
+// bundled human woman (joints from her file for KayKit's skeleton); frames computed in batches
+// and played while they arrive, the timeline played, paused and scrubbed with the real mouse;
+// one frame compared with `meshmorph retarget` (MM_CLI) on the same inputs; harmonic vs LBS;
+// an option change that recomputes (the run going is cancelled); the GLB downloaded, validated
+// (gltf-validator) and played again in the page; the joints JSON downloaded; errors shown.
+import fs from 'node:fs';
+import path from 'node:path';
+import { spawnSync } from 'node:child_process';
+
+// The vertices of an OBJ file the CLI wrote (17 significant digits).
+function readObjVertices(text) {
+  const out = [];
+  for (const line of text.split('\n')) {
+    if (line.startsWith('v ')) {
+      const [, x, y, z] = line.trim().split(/\s+/);
+      out.push(Number(x), Number(y), Number(z));
+    }
+  }
+  return out;
+}
+
+function heightOf(p) {
+  let lo = Infinity;
+  let hi = -Infinity;
+  for (let i = 1; i < p.length; i += 3) { lo = Math.min(lo, p[i]); hi = Math.max(hi, p[i]); }
+  return hi - lo;
+}
+
+export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, canvasPixels, pixelStats, repoDir, shotDir, cliPath, record }) {
+  const rtState = (page) => page.evaluate(() => JSON.parse(JSON.stringify(window.__meshmorph.state.retarget)));
+
+  function cli(args, label) {
+    check(fs.existsSync(cliPath), `the CLI is missing: ${cliPath} (set MM_CLI)`);
+    const run = spawnSync(cliPath, args, { encoding: 'utf8', timeout: 300000 });
+    check(run.status === 0, `meshmorph ${label} failed (${run.status}): ${run.stderr}${run.stdout}`);
+    return run.stdout;
+  }
+
+  // The CLI's frame k (target surface) for the same inputs, as an OBJ.
+  function cliFrame(args, k, name) {
+    const out = path.join(shotDir, `${name}.obj`);
+    cli(['retarget', ...args, '--out', out, '--frames', `${k}:${k + 1}`], 'retarget');
+    const file = out.replace(/\.obj$/, '_0000.obj');
+    return readObjVertices(fs.readFileSync(file, 'utf8'));
+  }
+
+  async function download(page, selector) {
+    const [file] = await Promise.all([page.waitForEvent('download', { timeout: 60000 }), page.click(selector)]);
+    const to = path.join(shotDir, file.suggestedFilename());
+    await file.saveAs(to);
+    return to;
+  }
+
+  async function openJob(page) {
+    await page.click('#jobs button[data-job="retarget"]');
+    await page.waitForSelector('#rt-character', { state: 'visible' });
+    await waitIdle(page);
+    await page.waitForFunction(() => document.querySelector('section.retarget .lil-gui.options'), null, { timeout: 30000 });
+  }
+
+  async function chooseCharacter(page, id) {
+    await page.selectOption('#rt-character', id);
+    await page.waitForFunction((i) => window.__meshmorph.state.retarget.source?.id === i && document.querySelectorAll('#rt-clip option').length > 0, id, { timeout: 60000 });
+  }
+
+  async function chooseTarget(page, id, { joints = true } = {}) {
+    await page.evaluate(() => { window.__meshmorph.state.error = null; });
+    await page.selectOption('#rt-target', id);
+    await page.waitForFunction((i) => window.__meshmorph.state.retarget.target?.id === i || window.__meshmorph.state.error, id, { timeout: 60000 });
+    await waitIdle(page);
+    if (joints) await page.waitForFunction(() => window.__meshmorph.state.retarget.joints > 0 || window.__meshmorph.state.error, null, { timeout: 30000 });
+    const error = await page.evaluate(() => window.__meshmorph.state.error);
+    check(!error, `target ${id}: ${JSON.stringify(error)}`);
+  }
+
+  // Filters the clip list by typing, then clicks the clip in the list (the real mouse).
+  async function chooseClip(page, name) {
+    await page.fill('#rt-clip-filter', name);
+    const value = await page.evaluate((n) => [...document.querySelectorAll('#rt-clip option')].find((o) => o.textContent.startsWith(`${n} `))?.value, name);
+    check(value != null, `clip ${name} not in the filtered list`);
+    await page.selectOption('#rt-clip', value);
+  }
+
+  async function waitRun(page, timeout = 180000) {
+    await page.waitForFunction(() => ['done', 'error'].includes(window.__meshmorph.state.retarget.run.status), null, { timeout });
+    const s = await rtState(page);
+    check(s.run.status === 'done', `the run failed: ${JSON.stringify(s.run.error)}`);
+    return s;
+  }
+
+  function compareFrame(pageFrame, cliFrameValues, label) {
+    check(pageFrame && pageFrame.length === cliFrameValues.length, `${label}: page frame has ${pageFrame?.length} values, CLI ${cliFrameValues.length}`);
+    let max = 0;
+    for (let i = 0; i < pageFrame.length; ++i) max = Math.max(max, Math.abs(pageFrame[i] - cliFrameValues[i]));
+    const rel = max / heightOf(cliFrameValues);
+    return rel;
+  }
+
+  it('retarget: KayKit Knight clip from the library onto the rigged Barbarian — preview, frames in batches, play, scrub, the CLI\'s frame, harmonic vs LBS, GLB validated and played again', async ({ page, browser, pageErrors }) => {
+    await openJob(page);
+    await shot(page, 'retarget-0-job');
+    await chooseCharacter(page, 'knight');
+    const s0 = await rtState(page);
+    check(s0.source.clips.length === 76, `Knight clips: ${s0.source.clips.length}`);
+    check(s0.step === 0, `step ${s0.step}`);
+    await shot(page, 'retarget-1-library');
+
+    // The target first (its joints from the skin, see-through), then the clip: the run starts
+    // when the clip is chosen, so the time to the first frame is the clip's.
+    await chooseTarget(page, 'barbarian');
+    const s1 = await rtState(page);
+    check(s1.target.skinned && s1.jointsFrom === 'skin' && s1.joints >= 20, `Barbarian joints: ${JSON.stringify({ skinned: s1.target.skinned, from: s1.jointsFrom, n: s1.joints })}`);
+    await nextFrame(page);
+    await shot(page, 'retarget-2-target-joints');
+
+    await chooseClip(page, 'Walking_A');
+    // The preview plays (its own canvas draws frames).
+    const previewFrames = await page.evaluate(() => window.__meshmorph.hooks.retargetPreviewFrames());
+    await page.waitForFunction((n) => window.__meshmorph.hooks.retargetPreviewFrames() > n + 3, previewFrames, { timeout: 10000 });
+    // The first frames play before the last ones are computed.
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.shownFrames > 0, null, { timeout: 120000 });
+    const early = await rtState(page);
+    await shot(page, 'retarget-3-first-frames');
+    const s2 = await waitRun(page);
+    check(s2.firstFrameMs > 0, 'no first-frame time');
+    check(early.run.received < s2.run.frames || early.run.status === 'done', 'frames did not arrive in batches');
+    record(browser, 'retarget Knight → Barbarian: clip chosen → first frame shown (ms)', s2.firstFrameMs);
+    record(browser, 'retarget Knight → Barbarian: prepare (ms)', s2.run.prepareMs);
+    check(s2.run.clip === 'Walking_A' && s2.run.frames >= 20, `run: ${JSON.stringify(s2.run)}`);
+    check(s2.playing, 'playback did not start when the frames arrived');
+    // Playing: the time moves and the shown surface changes.
+    const t0 = s2.time;
+    await page.waitForTimeout(400);
+    const s3 = await rtState(page);
+    check(s3.time !== t0, 'the clip time did not move while playing');
+    await shot(page, 'retarget-4-playing');
+
+    // Pause, then scrub with the mouse to 3/4 of the bar.
+    await page.click('#rt-play');
+    const paused = await rtState(page);
+    check(!paused.playing, 'pause did not pause');
+    const bar = await page.evaluate(() => window.__meshmorph.hooks.retargetScrubRect());
+    await page.mouse.click(bar.left + bar.width * 0.75, bar.top + bar.height / 2);
+    await nextFrame(page);
+    const scrubbed = await rtState(page);
+    const expected = bar.min + 0.75 * (bar.max - bar.min);
+    check(Math.abs(scrubbed.time - expected) < 0.06 * (bar.max - bar.min), `scrub: time ${scrubbed.time}, expected ≈ ${expected}`);
+    await shot(page, 'retarget-5-scrubbed');
+
+    // The shown surface at a frame's own time is that frame; frame 10 against the CLI.
+    const times = await page.evaluate(() => window.__meshmorph.hooks.retargetTimes());
+    const k = 10;
+    await page.evaluate((t) => window.__meshmorph.hooks.retargetSeek(t), times[k]);
+    const shown = await page.evaluate(() => window.__meshmorph.hooks.retargetShown());
+    const pageFrame = await page.evaluate((i) => window.__meshmorph.hooks.retargetFrame(i), k);
+    check(shown.every((v, i) => Math.abs(v - pageFrame[i]) < 1e-6), 'the shown surface is not frame 10 at its time');
+    const args = ['--source', path.join(repoDir, 'data/anim/KayKit/Knight.glb'), '--clip', 'Walking_A', '--target', path.join(repoDir, 'data/anim/KayKit/Barbarian.glb')];
+    const rel = compareFrame(pageFrame, cliFrame(args, k, 'retarget-cli-knight-barbarian'), 'Knight → Barbarian');
+    record(browser, 'retarget Knight → Barbarian frame 10: page vs CLI (max / height)', rel.toExponential(2));
+    check(rel < 1e-4, `frame ${k} differs from the CLI's by ${rel} of the height`);
+
+    // The LBS baseline: a new run (the harmonic one is replaced), other frames, also the CLI's.
+    await page.click('input[name="rt-method"][value="lbs"]');
+    const lbs = await waitRun(page);
+    check(lbs.run.options.method === 'lbs', `method ${lbs.run.options.method}`);
+    const lbsFrame = await page.evaluate((i) => window.__meshmorph.hooks.retargetFrame(i), k);
+    const relLbs = compareFrame(lbsFrame, cliFrame([...args, '--method', 'lbs'], k, 'retarget-cli-knight-barbarian-lbs'), 'LBS');
+    check(relLbs < 1e-4, `LBS frame ${k} differs from the CLI's by ${relLbs}`);
+    let differ = 0;
+    for (let i = 0; i < lbsFrame.length; ++i) differ = Math.max(differ, Math.abs(lbsFrame[i] - pageFrame[i]));
+    check(differ > 1e-3, 'harmonic and LBS frames are the same');
+    await page.evaluate((t) => window.__meshmorph.hooks.retargetSeek(t), times[k]);
+    await nextFrame(page);
+    await shot(page, 'retarget-6-lbs');
+    await page.click('input[name="rt-method"][value="harmonic"]');
+    await waitRun(page);
+
+    // Split panes.
+    await page.click('input[name="rt-view"][value="split"]');
+    await nextFrame(page);
+    await shot(page, 'retarget-7-split');
+    const split = pixelStats(await canvasPixels(page));
+    check(split.foreground > 0.02, `split view nearly empty (${split.foreground})`);
+    await page.click('input[name="rt-view"][value="side"]');
+
+    // Export: the GLB validates, the joints JSON has the skin's joints, the GLB plays here.
+    const glb = await download(page, '#rt-export');
+    const bytes = fs.readFileSync(glb);
+    const report = await (await import('gltf-validator')).validateBytes(new Uint8Array(bytes));
+    check(report.issues.numErrors === 0, `gltf-validator: ${report.issues.numErrors} errors: ${JSON.stringify(report.issues.messages.slice(0, 5))}`);
+    const jointsPath = await download(page, '#rt-joints-save');
+    const jointsJson = JSON.parse(fs.readFileSync(jointsPath, 'utf8'));
+    check(Object.keys(jointsJson).length === s1.joints, `joints JSON: ${Object.keys(jointsJson).length} of ${s1.joints}`);
+    await page.setInputFiles('#rt-play-file', glb);
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.played, null, { timeout: 30000 });
+    const played = await rtState(page);
+    check(played.played.morphTargets === s2.run.frames, `played GLB: ${JSON.stringify(played.played)}`);
+    check(played.playing, 'the opened GLB does not play');
+    await page.waitForTimeout(300);
+    await nextFrame(page);
+    await shot(page, 'retarget-8-glb-played');
+    const after = await rtState(page);
+    check(after.time !== played.time, 'the opened GLB\'s time does not move');
+    await page.click('#rt-back');
+    check(pageErrors.length === 0, `uncaught page errors: ${pageErrors.join(' | ')}`);
+  });
+
+  it('retarget: KayKit clip onto the bundled human woman with her joints file, matching the CLI; an option change recomputes; errors are readable', async ({ page, browser, pageErrors }) => {
+    await openJob(page);
+    if ((await rtState(page)).source?.id !== 'knight') {
+      await chooseCharacter(page, 'knight');
+      await chooseClip(page, 'Walking_A');
+    }
+    await chooseTarget(page, 'woman');
+    const s0 = await rtState(page);
+    check(s0.jointsFrom === 'file' && s0.joints === 18, `woman joints: ${s0.jointsFrom} ${s0.joints}`);
+    await shot(page, 'retarget-9-woman-joints');
+    const done = await waitRun(page);
+    check(done.target.vertices > 6000, `woman vertices ${done.target.vertices}`);
+    const k = 5;
+    await page.evaluate(() => window.__meshmorph.hooks.retargetSeek(0.5));
+    await nextFrame(page);
+    await shot(page, 'retarget-10-woman-playing');
+    const pageFrame = await page.evaluate((i) => window.__meshmorph.hooks.retargetFrame(i), k);
+    const rel = compareFrame(pageFrame, cliFrame(['--source', path.join(repoDir, 'data/anim/KayKit/Knight.glb'), '--clip', 'Walking_A',
+      '--target', path.join(repoDir, 'data/anim/human_woman.ply'), '--target-joints', path.join(repoDir, 'data/joints/human_woman_kaykit_joints.json')], k, 'retarget-cli-knight-woman'), 'Knight → woman');
+    record(browser, 'retarget Knight → woman frame 5: page vs CLI (max / height)', rel.toExponential(2));
+    check(rel < 1e-4, `frame ${k} differs from the CLI's by ${rel} of the height`);
+    const plot = await page.evaluate(() => window.__meshmorph.hooks.retargetPlot());
+    check(plot && plot.every(Number.isFinite), 'no bone-length plot');
+
+    // An option change while frames are computing: the run going is cancelled, a new one runs
+    // with the option (fps 15 → about half the frames).
+    const runs = done.runs;
+    await page.click('section.retarget .lil-gui.options > .lil-title');
+    await page.fill('#opt-fps', '15');
+    await page.click('section.retarget h2'); // the field loses focus: lil-gui's finish-change
+    await page.waitForFunction((n) => window.__meshmorph.state.retarget.runs > n, runs, { timeout: 10000 });
+    const fewer = await waitRun(page);
+    check(Math.abs(fewer.run.frames - Math.ceil(done.run.frames / 2)) <= 1, `fps 15: ${fewer.run.frames} frames vs ${done.run.frames} at 30`);
+    await page.fill('#opt-fps', '30');
+    await page.click('section.retarget h2'); // the field loses focus: lil-gui's finish-change
+    await waitRun(page);
+
+    // A source whose skeleton the woman's joints were not placed for: the page says so.
+    await chooseCharacter(page, 'robot');
+    await chooseClip(page, 'Wave');
+    const robot = await rtState(page);
+    const info = await page.textContent('#rt-target-info');
+    check(robot.joints === 0 && /not for RobotExpressive/.test(info), `robot on woman: ${robot.joints} joints, "${info}"`);
+    await shot(page, 'retarget-11-no-joints-for-robot');
+    // A joints file of wrong names: the core's message is shown, the page recovers.
+    const bad = path.join(shotDir, 'retarget-bad-joints.json');
+    fs.writeFileSync(bad, JSON.stringify({ nosuchjoint: [0, 1, 0], another: [0, 0.5, 0] }));
+    await page.evaluate(() => { window.__meshmorph.state.error = null; });
+    await page.setInputFiles('#rt-joints-file', bad);
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.run.status === 'error', null, { timeout: 60000 });
+    const error = await page.evaluate(() => window.__meshmorph.state.error);
+    check(error && /nosuchjoint|another/.test(error.message), `error: ${JSON.stringify(error)}`);
+    await shot(page, 'retarget-12-error');
+    // Back to a clip the woman has joints for.
+    await chooseCharacter(page, 'knight');
+    await chooseTarget(page, 'woman');
+    await chooseClip(page, 'Idle');
+    await waitRun(page);
+    check(pageErrors.length === 0, `uncaught page errors: ${pageErrors.join(' | ')}`);
+  });
+  it('retarget: the person\'s own files — a skinned GLB as the source, a PLY target with its joints file', async ({ page, pageErrors }) => {
+    await openJob(page);
+    await page.setInputFiles('#rt-source-file', path.join(repoDir, 'data/anim/CesiumMan/CesiumMan.glb'));
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.source?.id === 'file', null, { timeout: 60000 });
+    await page.setInputFiles('#rt-target-file', path.join(repoDir, 'data/anim/human_woman.ply'));
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.target?.id === 'file', null, { timeout: 60000 });
+    await waitIdle(page);
+    const s0 = await rtState(page);
+    check(s0.jointsFrom === 'file' && s0.joints === 0, `own PLY target: joints ${s0.jointsFrom} ${s0.joints}`);
+    await page.setInputFiles('#rt-joints-file', path.join(repoDir, 'data/joints/human_woman_joints.json'));
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.joints === 19, null, { timeout: 30000 });
+    // CesiumMan's one clip has no name: it is listed as "(unnamed clip 1)".
+    const label = await page.textContent('#rt-clip option');
+    check(/unnamed clip 1/.test(label), `clip label ${label}`);
+    await page.selectOption('#rt-clip', '0');
+    const done = await waitRun(page);
+    check(done.run.frames > 10 && done.source.clipName === '', `CesiumMan run: ${JSON.stringify(done.run)}`);
+    await page.evaluate(() => window.__meshmorph.hooks.retargetSeek(1.0));
+    await nextFrame(page);
+    await shot(page, 'retarget-13-own-files');
+    check(pageErrors.length === 0, `uncaught page errors: ${pageErrors.join(' | ')}`);
+  });
+}

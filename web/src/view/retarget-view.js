@@ -1,0 +1,328 @@
+// The Retarget job's scene (ui/panels/retarget.js): the source character (the glTF scene as
+// three.js loads it, posed by an AnimationMixer at the clip time) and the target (the
+// retargeted surface, its positions swapped per frame; or an animated GLB played by its own
+// mixer), side by side in one pane or in two split panes (Viewer.setSplit, linked cameras or
+// not). The target can be drawn see-through with its joints (spheres) and bones (lines) over it.
+// Each side is scaled to the same display height and stands on the same floor; its placement is
+// fixed from its rest pose, so root motion shows.
+import * as THREE from 'three';
+
+const sphere = new THREE.SphereGeometry(1, 14, 10);
+const gap = 0.35; // between the two characters, in display heights
+const targetColor = 0xd8cdbf;
+
+// A box's 8 corners as a mesh: Viewer.frameMeshes frames meshes by their vertices.
+function boxProxy(box) {
+  const geometry = new THREE.BufferGeometry();
+  const p = [];
+  for (const x of [box.min.x, box.max.x]) for (const y of [box.min.y, box.max.y]) for (const z of [box.min.z, box.max.z]) p.push(x, y, z);
+  geometry.setAttribute('position', new THREE.Float32BufferAttribute(p, 3));
+  geometry.computeBoundingBox();
+  const mesh = new THREE.Mesh(geometry);
+  mesh.visible = false;
+  return mesh;
+}
+
+function createSide(name) {
+  const root = new THREE.Group(); // display placement (scale, offset)
+  root.name = `retarget-${name}`;
+  return { name, root, box: null, proxy: null, loaded: false };
+}
+
+export class RetargetView {
+  constructor(viewer) {
+    this.viewer = viewer;
+    this.group = new THREE.Group();
+    this.group.visible = false;
+    viewer.scene.add(this.group);
+    this.sides = { source: createSide('source'), target: createSide('target') };
+    this.group.add(this.sides.source.root, this.sides.target.root);
+    this.mode = 'side';
+    this.linked = true;
+    // Source: the glTF scene, its mixer and the playing action.
+    this.source = { scene: null, mixer: null, action: null };
+    // Target: the surface mesh (positions swapped per frame) or a played GLB.
+    this.targetMaterial = new THREE.MeshStandardMaterial({
+      color: targetColor, roughness: 0.62, metalness: 0, side: THREE.DoubleSide,
+      polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1,
+    });
+    this.targetMesh = new THREE.Mesh(new THREE.BufferGeometry(), this.targetMaterial);
+    this.targetMesh.name = 'retarget-target-surface';
+    this.targetMesh.visible = false;
+    this.sides.target.root.add(this.targetMesh);
+    this.played = null; // {scene, mixer, action, duration} of an opened animated GLB
+    // Joints overlay (children of the target side: target coordinates).
+    this.jointGroup = new THREE.Group();
+    this.jointGroup.renderOrder = 2;
+    this.sides.target.root.add(this.jointGroup);
+    this.jointMaterial = new THREE.MeshBasicMaterial({ color: 0xffd23f, depthTest: false, transparent: true });
+    this.boneMaterial = new THREE.LineBasicMaterial({ color: 0x39e6a0, depthTest: false, transparent: true });
+    this.joints = { spheres: [], lines: null, bones: [], count: 0 };
+    this.seeThrough = false;
+  }
+
+  get active() { return this.group.visible; }
+
+  setActive(on) {
+    if (this.group.visible === on) return;
+    this.group.visible = on;
+    this.viewer.setMainVisible(!on);
+    this.applySplit();
+    if (on) this.frame();
+    this.viewer.requestRender();
+  }
+
+  // 'side' | 'split'; linked: the split panes' cameras move together.
+  setMode(mode, { linked = this.linked } = {}) {
+    const changed = mode !== this.mode;
+    this.mode = mode;
+    this.linked = linked;
+    this.layout();
+    this.applySplit();
+    if (changed) this.frame();
+    this.viewer.requestRender();
+  }
+
+  applySplit() {
+    const { viewer } = this;
+    if (!(this.active && this.mode === 'split')) {
+      if (viewer.split) viewer.setSplit(null);
+      return;
+    }
+    const { source, target } = this.sides;
+    viewer.setSplit({
+      linked: this.linked,
+      beforePass: (i) => { source.root.visible = i === 0; target.root.visible = i === 1; },
+      afterPasses: () => { source.root.visible = true; target.root.visible = true; },
+    });
+  }
+
+  // ---- source
+
+  // gltf: GLTFLoader's result (its scene is added here: do not add it elsewhere). The rest
+  // box is measured at time 0 of `clipIndex` (or the bind pose without clips).
+  setSource(gltf, clipIndex = 0) {
+    const side = this.sides.source;
+    if (this.source.scene) side.root.remove(this.source.scene);
+    this.source.mixer?.stopAllAction();
+    this.source = { scene: gltf.scene, mixer: new THREE.AnimationMixer(gltf.scene), action: null, clips: gltf.animations };
+    side.root.add(gltf.scene);
+    this.setClip(clipIndex);
+    this.measure('source');
+  }
+
+  setClip(index) {
+    const { mixer, clips } = this.source;
+    if (!mixer) return;
+    mixer.stopAllAction();
+    this.source.action = null;
+    const clip = clips[index];
+    if (clip) {
+      this.source.action = mixer.clipAction(clip);
+      this.source.action.play();
+    }
+    mixer.setTime(0);
+    this.viewer.requestRender();
+  }
+
+  // The source at clip time t (seconds).
+  setSourceTime(t) {
+    if (!this.source.mixer || !this.source.action) return;
+    this.source.mixer.setTime(t);
+  }
+
+  // ---- target
+
+  // The target surface: {positions (#V·3), indices}; replaces a played GLB.
+  setTargetMesh({ positions, indices }) {
+    this.clearPlayed();
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute('position', new THREE.BufferAttribute(Float32Array.from(positions), 3));
+    geometry.setIndex(new THREE.BufferAttribute(indices instanceof Uint32Array ? indices : Uint32Array.from(indices), 1));
+    geometry.computeVertexNormals();
+    geometry.computeBoundingBox();
+    geometry.computeBoundingSphere();
+    this.targetMesh.geometry.dispose();
+    this.targetMesh.geometry = geometry;
+    this.targetMesh.visible = true;
+    this.measure('target', geometry.boundingBox.clone());
+  }
+
+  // New target positions (same vertices): a frame of the retargeted clip.
+  setTargetPositions(positions) {
+    const attribute = this.targetMesh.geometry.getAttribute('position');
+    if (!attribute || attribute.array.length !== positions.length) return;
+    attribute.array.set(positions);
+    attribute.needsUpdate = true;
+    this.targetMesh.geometry.computeVertexNormals();
+    this.viewer.requestRender();
+  }
+
+  targetPositions() {
+    return this.targetMesh.geometry.getAttribute('position')?.array ?? null;
+  }
+
+  // See-through target (joints and bones show over it).
+  setSeeThrough(on) {
+    this.seeThrough = on;
+    const m = this.targetMaterial;
+    m.transparent = on;
+    m.opacity = on ? 0.35 : 1;
+    m.depthWrite = !on;
+    m.needsUpdate = true;
+    this.viewer.requestRender();
+  }
+
+  // Joints (Float32Array or [x,y,z][] in target coordinates) and bones ([child, parent]).
+  setJoints(positions, bones = []) {
+    this.clearJoints();
+    const flat = Array.isArray(positions) ? positions.flat() : Array.from(positions);
+    const count = flat.length / 3;
+    const box = this.sides.target.box;
+    const size = box ? box.getSize(new THREE.Vector3()).y || box.getSize(new THREE.Vector3()).length() : 1;
+    const radius = 0.012 * size;
+    for (let j = 0; j < count; ++j) {
+      const s = new THREE.Mesh(sphere, this.jointMaterial);
+      s.scale.setScalar(radius);
+      s.renderOrder = 3;
+      this.jointGroup.add(s);
+      this.joints.spheres.push(s);
+    }
+    const lineGeometry = new THREE.BufferGeometry();
+    lineGeometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(bones.length * 6), 3));
+    this.joints.lines = new THREE.LineSegments(lineGeometry, this.boneMaterial);
+    this.joints.lines.renderOrder = 2;
+    this.joints.lines.frustumCulled = false;
+    this.jointGroup.add(this.joints.lines);
+    this.joints.bones = bones;
+    this.joints.count = count;
+    this.moveJoints(flat);
+  }
+
+  // New joint positions (same joints): the joints following a frame.
+  moveJoints(flat) {
+    const { spheres, lines, bones } = this.joints;
+    spheres.forEach((s, j) => s.position.set(flat[3 * j], flat[3 * j + 1], flat[3 * j + 2]));
+    if (lines) {
+      const p = lines.geometry.getAttribute('position');
+      bones.forEach(([a, b], i) => {
+        p.setXYZ(2 * i, flat[3 * a], flat[3 * a + 1], flat[3 * a + 2]);
+        p.setXYZ(2 * i + 1, flat[3 * b], flat[3 * b + 1], flat[3 * b + 2]);
+      });
+      p.needsUpdate = true;
+    }
+    this.viewer.requestRender();
+  }
+
+  clearJoints() {
+    for (const s of this.joints.spheres) this.jointGroup.remove(s);
+    if (this.joints.lines) {
+      this.jointGroup.remove(this.joints.lines);
+      this.joints.lines.geometry.dispose();
+    }
+    this.joints = { spheres: [], lines: null, bones: [], count: 0 };
+    this.viewer.requestRender();
+  }
+
+  setJointsVisible(on) {
+    this.jointGroup.visible = on;
+    this.viewer.requestRender();
+  }
+
+  // An animated GLB (a retargeted export opened again) instead of the surface: played by its
+  // own mixer; playedTime(t) poses it.
+  setPlayed(gltf) {
+    this.clearPlayed();
+    this.clearJoints();
+    const mixer = new THREE.AnimationMixer(gltf.scene);
+    const clip = gltf.animations[0] ?? null;
+    const action = clip ? mixer.clipAction(clip) : null;
+    action?.play();
+    mixer.setTime(0);
+    this.played = { scene: gltf.scene, mixer, action, duration: clip?.duration ?? 0 };
+    this.targetMesh.visible = false;
+    // Measured in its own coordinates, before it hangs under the placed side.
+    gltf.scene.updateMatrixWorld(true);
+    const box = new THREE.Box3().setFromObject(gltf.scene);
+    this.sides.target.root.add(gltf.scene);
+    this.measure('target', box);
+  }
+
+  setPlayedTime(t) {
+    if (!this.played) return;
+    this.played.mixer.setTime(t);
+    this.viewer.requestRender();
+  }
+
+  clearPlayed() {
+    if (!this.played) return;
+    this.played.mixer.stopAllAction();
+    this.sides.target.root.remove(this.played.scene);
+    this.played = null;
+  }
+
+  // ---- placement
+
+  // A side's rest box (its own coordinates); the source's is measured from its scene.
+  measure(name, box = null) {
+    const side = this.sides[name];
+    if (!box) {
+      const scene = this.source.scene;
+      scene.updateMatrixWorld(true);
+      side.root.updateMatrixWorld(true);
+      box = new THREE.Box3();
+      const inverse = side.root.matrixWorld.clone().invert();
+      scene.traverse((o) => {
+        if (!o.isMesh || !o.geometry) return;
+        o.geometry.computeBoundingBox?.();
+        if (o.isSkinnedMesh) o.computeBoundingBox();
+        const b = (o.boundingBox ?? o.geometry.boundingBox).clone().applyMatrix4(o.matrixWorld).applyMatrix4(inverse);
+        box.union(b);
+      });
+    }
+    side.box = box;
+    if (side.proxy) side.root.remove(side.proxy);
+    side.proxy = boxProxy(box);
+    side.root.add(side.proxy);
+    side.loaded = true;
+    this.layout();
+    this.frame();
+  }
+
+  // Each side scaled to display height 1 (its box's height), its box centred in x and z and
+  // standing on y = 0; side by side the source is left, the target right.
+  layout() {
+    for (const side of Object.values(this.sides)) {
+      if (!side.box) continue;
+      const size = side.box.getSize(new THREE.Vector3());
+      const height = size.y > 0 ? size.y : size.length() || 1;
+      const scale = 1 / height;
+      const center = side.box.getCenter(new THREE.Vector3());
+      side.root.scale.setScalar(scale);
+      side.root.position.set(-center.x * scale, -side.box.min.y * scale, -center.z * scale);
+      if (this.mode === 'side') side.root.position.x += (side.name === 'source' ? -1 : 1) * (0.5 + gap / 2) * Math.max(1, size.x * scale);
+    }
+    this.group.updateMatrixWorld(true);
+  }
+
+  frame() {
+    if (!this.active) return;
+    const proxies = Object.values(this.sides).filter((s) => s.proxy).map((s) => s.proxy);
+    if (!proxies.length) return;
+    this.viewer.frameMeshes(proxies, { direction: [0, 0.25, 1] });
+    if (this.mode === 'split') this.viewer.frameMeshes(proxies, { direction: [0, 0.25, 1], pane: 1 });
+  }
+
+  // Which pane shows a side, its camera and rectangle.
+  view(name) {
+    const pane = this.mode === 'split' && this.active && name === 'target' ? 1 : 0;
+    return { pane, camera: this.viewer.paneCamera(pane), rect: this.viewer.paneRect(pane) };
+  }
+
+  // Client pixel of a point in a side's coordinates.
+  toScreen(name, point) {
+    const { camera, rect } = this.view(name);
+    const p = new THREE.Vector3(...point).applyMatrix4(this.sides[name].root.matrixWorld).project(camera);
+    return { x: rect.left + ((p.x + 1) / 2) * rect.width, y: rect.top + ((1 - p.y) / 2) * rect.height };
+  }
+}
