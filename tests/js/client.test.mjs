@@ -169,7 +169,9 @@ test('a worker that dies (uncaught error) is replaced and the mesh restored', as
   try {
     await client.ready;
     await loadArmadillo(client);
-    await client.run('debugCrash').promise;
+    // The op answers and then the worker dies; under load the death can overtake the answer, so
+    // the request may also be rejected as Crashed.
+    await client.run('debugCrash').promise.catch((e) => { if (e.code !== 'Crashed') throw e; });
     for (let i = 0; i < 100 && !restarts.length; ++i) await new Promise((resolve) => setTimeout(resolve, 50));
     assert.equal(restarts.length, 1, 'no restart after the worker died');
     assert.equal(restarts[0].code, 'Crashed');
