@@ -444,7 +444,7 @@ Status BatchWorker::run_merge(const BatchJob& job, const Progress& progress, Bat
 
 #ifndef __EMSCRIPTEN__
 namespace {
-bool write_all(int fd, const std::string& s) {
+bool worker_write_all(int fd, const std::string& s) {
   size_t done = 0;
   while (done < s.size()) {
     const ssize_t w = ::write(fd, s.data() + done, s.size() - done);
@@ -489,11 +489,11 @@ int run_batch_worker_loop(int in_fd, int out_fd, bool reuse) {
       last = now;
       char msg[96];
       std::snprintf(msg, sizeof msg, "{\"event\":\"progress\",\"index\":%d,\"f\":%.3f}\n", index, std::clamp(f, 0.0, 1.0));
-      write_all(out_fd, msg);
+      worker_write_all(out_fd, msg);
       return true;
     });
     o = worker.run(job, progress);
-    if (!write_all(out_fd, batch_done_message(o))) return 1;
+    if (!worker_write_all(out_fd, batch_done_message(o))) return 1;
   }
 }
 #else
