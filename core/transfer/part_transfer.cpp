@@ -133,9 +133,9 @@ void part_seam_dihedral(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, cons
 }
 
 // Isoline perimeters of the geodesic distance from `tip` and the radius of the narrowest neck
-// (see header): 0 when no cut fits between `r_min` and the area cap.
+// (see header): 0 when no cut fits between `r_min`, `r_max` (0 = no bound) and the area cap.
 double part_neck_radius(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
-                        const std::vector<std::vector<int>>& adj, int tip, double r_min,
+                        const std::vector<std::vector<int>>& adj, int tip, double r_min, double r_max,
                         const PartTransferOptions& opt) {
   const int n = static_cast<int>(V.rows());
   std::vector<double> d(n, std::numeric_limits<double>::infinity());
@@ -178,7 +178,7 @@ double part_neck_radius(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   for (int k = 1; k < N; ++k) area[k] += area[k - 1];
   int k_lo = -1, k_hi = -1;
   for (int k = 0; k < N; ++k) {
-    if (area[k] > opt.max_part_area * total) break;
+    if (area[k] > opt.max_part_area * total || (r_max > 0 && level(k) > r_max)) break;
     k_hi = k;
     if (k_lo < 0 && level(k) >= r_min && area[k] >= 0.01 * total && perim[k] > 0) k_lo = k;
   }
@@ -324,11 +324,41 @@ PartsSpec propose_parts(const Mesh& reference, const Mesh& source, const Eigen::
   std::vector<double> d(n, 0.0);
   RigidFitOptions fo;
   fo.scale = true;
+  const auto adj_s = vertex_adjacency(source.F, n);
   if (same) {
+    // Local pose disagreement: the rotation angle (degrees) of the best rigid fit of each
+    // vertex's `disagreement_rings`-ring from the (globally aligned) level-1 result onto the
+    // reference. A limb the low frequencies left mis-oriented rotates as a whole, so the angle is
+    // high along all of it and falls off at its joint, where the cut belongs.
     const RigidFit fit = fit_rigid(transferred, reference.V, fo);
-    for (int i = 0; i < n; ++i)
-      d[i] = (fit.s * fit.R * transferred.row(i).transpose() + fit.t - reference.V.row(i).transpose()).norm() / diag_ref;
+    const Eigen::MatrixXd aligned = (fit.s * transferred * fit.R.transpose()).rowwise() + fit.t.transpose();
+    for (int i = 0; i < n; ++i) {
+      const std::vector<int> ring = k_ring(adj_s, i, opt.disagreement_rings);
+      if (ring.size() < 4) continue;
+      Eigen::MatrixXd A(ring.size(), 3), B(ring.size(), 3);
+      for (size_t k = 0; k < ring.size(); ++k) {
+        A.row(static_cast<Eigen::Index>(k)) = aligned.row(ring[k]);
+        B.row(static_cast<Eigen::Index>(k)) = reference.V.row(ring[k]);
+      }
+      RigidFitOptions ro;
+      ro.min_spread = 0.05;  // a nearly collinear ring has no well-defined rotation
+      const RigidFit local = fit_rigid(A, B, ro);
+      d[i] = local.degenerate ? 0.0 : Eigen::AngleAxisd(local.R).angle() * 180.0 / M_PI;
+    }
+    // Two passes of 1-ring averaging: single vertices with an ill-conditioned ring (a flat ear
+    // tip can flip its best rotation by 180°) do not become seeds.
+    for (int pass = 0; pass < 2; ++pass) {
+      std::vector<double> sm(n, 0.0);
+      for (int i = 0; i < n; ++i) {
+        double sum = d[i];
+        for (int w : adj_s[i]) sum += d[w];
+        sm[i] = sum / (1 + adj_s[i].size());
+      }
+      d.swap(sm);
+    }
   } else if (!landmarks.empty()) {
+    // Only the landmark pairs correspond: their distance after a similarity fit, in degrees of
+    // the same scale (1 degree per 1/180 of the diagonal) so that one threshold serves both.
     Eigen::MatrixXd P(landmarks.size(), 3), Q(landmarks.size(), 3);
     for (size_t k = 0; k < landmarks.size(); ++k) {
       P.row(static_cast<Eigen::Index>(k)) = transferred.row(landmarks[k].source);
@@ -336,11 +366,10 @@ PartsSpec propose_parts(const Mesh& reference, const Mesh& source, const Eigen::
     }
     const RigidFit fit = fit_rigid(P, Q, fo);
     for (size_t k = 0; k < landmarks.size(); ++k)
-      d[landmarks[k].source] = (fit.s * fit.R * P.row(static_cast<Eigen::Index>(k)).transpose() + fit.t -
-                                Q.row(static_cast<Eigen::Index>(k)).transpose()).norm() / diag_ref;
+      d[landmarks[k].source] = 180.0 * (fit.s * fit.R * P.row(static_cast<Eigen::Index>(k)).transpose() + fit.t -
+                                        Q.row(static_cast<Eigen::Index>(k)).transpose()).norm() / diag_ref;
   }
   if (disagreement) *disagreement = d;
-  const auto adj_s = vertex_adjacency(source.F, n);
   const auto adj_r = same ? std::vector<std::vector<int>>{} : vertex_adjacency(reference.F, reference.num_vertices());
   const Eigen::VectorXd a = mass_diagonal(source.V, source.F);
   const Eigen::RowVector3d centroid = (a.transpose() * source.V) / std::max(a.sum(), 1e-300);
@@ -376,7 +405,8 @@ PartsSpec propose_parts(const Mesh& reference, const Mesh& source, const Eigen::
     std::vector<double> dt(n, std::numeric_limits<double>::infinity());
     relax_edge_distances(source.V, adj_s, tip, &dt);
     for (int v : blob) r_blob = std::max(r_blob, dt[v]);
-    const double radius = part_neck_radius(source.V, source.F, adj_s, tip, r_blob, opt);
+    const double radius = part_neck_radius(source.V, source.F, adj_s, tip, opt.neck_window_begin * r_blob,
+                                           opt.neck_window_end * r_blob, opt);
     // Mark the region (and what the disk would cover) taken either way, so the next proposal
     // looks elsewhere.
     for (int v : blob) taken[v] = 1;
@@ -393,7 +423,7 @@ PartsSpec propose_parts(const Mesh& reference, const Mesh& source, const Eigen::
     if (same) {
       pp.reference = pp.source;
     } else {
-      const double rr = part_neck_radius(reference.V, reference.F, adj_r, tip_ref, 0, opt);
+      const double rr = part_neck_radius(reference.V, reference.F, adj_r, tip_ref, 0, 0, opt);
       if (!(rr > 0)) continue;
       pp.reference.kind = PartRegionKind::Disk;
       pp.reference.seed = tip_ref;
@@ -479,15 +509,19 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     // Step 3: Transfer I on the pair.
     std::vector<LandmarkPair> lm;
     const bool same_pair = S.F.rows() == R.F.rows() && S.F == R.F;
-    if (!same_pair) lm = part_landmarks(R, S, landmarks, nR, nS);
+    if (same_pair) R.tip = S.tip;  // one frame construction for both (the distances differ slightly by pose)
+    else lm = part_landmarks(R, S, landmarks, nR, nS);
     PoseTransferOptions topt = opt.transfer;
     topt.cage.target_vertices = opt.part_cage_vertices;
+    topt.cage.resolution = opt.part_cage_resolution;
     topt.placement = TransferPlacement::Reference;
     Mesh Sm{Ssub.V, Ssub.F}, Rm{Rsub.V, Rsub.F};
     const PoseTransferResult t = pose_transfer(Rm, Sm, lm, topt, pp_progress.sub(0.0, 0.8));
     if (t.status.code == StatusCode::Cancelled) return t.status;
     rep.landmarks = static_cast<int>(t.landmarks.size());
+    rep.transfer_ms = t.ms;
     if (!t.status.ok()) return skip(t.status);
+    const auto t_glue = clock::now();
     Eigen::MatrixXd T;
     Eigen::MatrixXi Fc;
     butterfly_coarsen(t.V, Ssub.F, levels, static_cast<int>(S.V.rows()), &T, &Fc);
@@ -556,6 +590,7 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     rep.seam_dihedral_mean_before = l1_mean;
     rep.seam_dihedral_max_before = l1_max;
     Vcur = fin.V;
+    rep.glue_ms = part_ms_since(t_glue);
     rep.ms = part_ms_since(t0);
     out.reports.push_back(rep);
     return Status::success();

@@ -31,9 +31,14 @@
 //     coordinates ("before the rotation") up to the similarities the editor derives.
 //
 // Automatic proposals (the paper leaves parts to the person; issue 16): the per-vertex pose
-// disagreement between the level-1 result and the reference (same connectivity: distance after a
-// similarity fit of M̃ to the reference; different connectivity: at the landmark pairs only) is
-// largest on the limbs, head or tail that the K low frequencies did not pose. From the worst
+// disagreement between the level-1 result and the reference is largest on the limbs, head or
+// tail that the K low frequencies did not pose. Same connectivity: after a global similarity fit,
+// the rotation angle (degrees) of the best rigid fit of each vertex's 3-ring onto the
+// reference's — a mis-oriented limb rotates as a whole, so the angle is high all along it and
+// falls off at the joint (a plain distance grows towards the tip and spreads over the body: on
+// cat-01 the region above 30% of the largest distance covered 87% of the surface). Different
+// connectivity: only the landmark pairs correspond; their distance after a similarity fit, in
+// units of 1/180 of the diagonal ("degrees") so one threshold serves both. From the worst
 // vertex's region a tip is taken (the high-disagreement vertex farthest from the centroid, or
 // the landmark itself), and a geodesic disk around it is grown to a neck: along the geodesic
 // isolines from the tip, the cut is at the narrowest isoline (shortest perimeter) in a window
@@ -68,13 +73,17 @@ namespace mm {
 struct PartTransferOptions {
   PoseTransferOptions transfer;  // Transfer I for level 1 and every part (paper defaults)
   int part_cage_vertices = 200;  // automatic cage per part (Table 1: 166–520 for whole bodies)
+  int part_cage_resolution = 48; // its offset grid (cells along the longest side; whole body: 80)
   int min_part_vertices = 2000;  // subdivide a part while it has fewer vertices than this
   int max_subdivisions = 2;      // paper: "once or twice"; 0 = never
   int seam_rings = 3;            // edges on each side of a cut that the gluing step smooths (≥ 1)
   // Automatic proposals.
   int max_parts = 4;             // at most this many proposed parts (one level)
-  double min_disagreement = 0.03; // propose only where the disagreement exceeds this × bbox diagonal
-  double blob_fraction = 0.3;    // high-disagreement region: ≥ this × the worst vertex's value
+  double min_disagreement = 15;  // propose only where the disagreement exceeds this (degrees; see header)
+  int disagreement_rings = 3;    // neighbourhood of the local rotation fit (same connectivity)
+  double blob_fraction = 0.5;    // high-disagreement region: ≥ this × the worst vertex's value
+  double neck_window_begin = 0.75; // the neck is searched between these multiples of the
+  double neck_window_end = 1.5;    // high-disagreement region's geodesic extent from the tip
   double neck_ratio = 2.0;       // isoline perimeter growth (× narrowest so far) that marks the body
   double max_part_area = 0.3;    // a proposed part covers at most this fraction of the surface
 };
@@ -107,6 +116,8 @@ struct PartReport {
   double seam_dihedral_mean = 0, seam_dihedral_max = 0;
   double seam_dihedral_mean_before = 0, seam_dihedral_max_before = 0;
   double ms = 0;                 // wall time of this part
+  PoseTransferTimings transfer_ms; // of its Transfer I
+  double glue_ms = 0;            // registration and gluing (editor precompute + solves)
 };
 
 struct PartTransferResult {
