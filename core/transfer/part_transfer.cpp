@@ -413,6 +413,9 @@ PartsSpec propose_parts(const Mesh& reference, const Mesh& source, const Eigen::
     for (int v = 0; v < n; ++v)
       if (dt[v] < std::max(radius, r_blob) * 1.15) taken[v] = 1;
     if (!(radius > 0) || tip_ref < 0) continue;
+    int inside = 0;
+    for (int v = 0; v < n; ++v) inside += dt[v] < radius;
+    if (inside < opt.min_part_fraction * n) continue;  // too small to carry a pose of its own
     PartPair pp;
     char name[96];
     std::snprintf(name, sizeof name, "auto %d (disagreement %.3f at vertex %d)", p + 1, d[worst], worst);
@@ -469,6 +472,18 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
   };
   const int total_parts = count_parts(out.parts.parts);
   int done = 0;
+  // Running fold counts of Vcur and the level's landmark error (quality gate, see transfer_part).
+  int si_current = out.folds_level1.self_intersections_result;
+  int flips_current = out.folds_level1.flipped_faces;
+  const std::vector<LandmarkPair>& level_pairs = out.level1.landmarks;
+  Eigen::MatrixXd lm_ref(level_pairs.size(), 3);
+  for (size_t k = 0; k < level_pairs.size(); ++k)
+    lm_ref.row(static_cast<Eigen::Index>(k)) = reference.V.row(level_pairs[k].reference);
+  auto lm_error = [&](const Eigen::MatrixXd& X) {
+    Eigen::MatrixXd lm(level_pairs.size(), 3);
+    for (size_t k = 0; k < level_pairs.size(); ++k) lm.row(static_cast<Eigen::Index>(k)) = X.row(level_pairs[k].source);
+    return aligned_vertex_error(lm, lm_ref);
+  };
 
   // One part pair (header, steps 1–5) on the current result Vcur.
   auto transfer_part = [&](const PartPair& pp, int level) -> Status {
@@ -534,6 +549,11 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     if (axis_t || axis_r) Rot = Eigen::Quaterniond::FromTwoVectors(Et.col(0), Er.col(0)).toRotationMatrix();
     else Rot = Er * Et.transpose();
     rep.rotation_degrees = Eigen::AngleAxisd(Rot).angle() * 180.0 / M_PI;
+    // Transfer I already gives the part the reference part's orientation (the low frequencies
+    // carry it), so a large frame rotation means an ill-conditioned frame (a short or straight
+    // part whose average point lies near the axis): measured up to 167° on cat-07/cat-05 parts,
+    // all rejected by the gate below. Such rotations are not applied.
+    if (rep.rotation_degrees > opt.max_registration_degrees) Rot.setIdentity();
     const Eigen::Vector3d bt = part_boundary_centroid(T, S.boundary);
     const Eigen::Vector3d bs = part_boundary_centroid(S.V, S.boundary);
     Eigen::MatrixXd Treg(T.rows(), 3);
@@ -586,6 +606,26 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     EditResult fin = editor.finalize(FeatureSize::Keep);
     if (!fin.status.ok()) return skip(Status::error(fin.status.code, "gluing: " + fin.status.message));
     if (!fin.V.allFinite()) return skip(Status::error(StatusCode::NumericalError, "gluing produced non-finite positions"));
+    // Quality gate: keep the part only if it brings the level's landmark pairs closer to the
+    // reference (after a similarity fit) and adds no self-intersection and no flipped face.
+    const int si_after = self_intersections(fin.V, source.F).pairs;
+    const int flips_after = transfer_metrics(fin.V, source.V, source.F).flipped_faces;
+    rep.landmark_error_before = lm_error(Vcur);
+    rep.landmark_error_after = lm_error(fin.V);
+    rep.self_intersections_added = si_after - si_current;
+    rep.flips_added = flips_after - flips_current;
+    if (opt.reject_worse_parts) {
+      std::string why;
+      if (si_after > si_current) why += ", adds " + std::to_string(si_after - si_current) + " self-intersecting pairs";
+      if (flips_after > flips_current) why += ", adds " + std::to_string(flips_after - flips_current) + " flipped faces";
+      if (rep.landmark_error_after > rep.landmark_error_before) why += ", moves the landmarks away from the reference";
+      if (!why.empty()) {
+        rep.rejected = true;
+        return skip(Status::error(StatusCode::NotConverged, "rejected: the glued part" + why.substr(1)));
+      }
+    }
+    si_current = si_after;
+    flips_current = flips_after;
     part_seam_dihedral(fin.V, source.V, source.F, in_part, &rep.seam_dihedral_mean, &rep.seam_dihedral_max);
     rep.seam_dihedral_mean_before = l1_mean;
     rep.seam_dihedral_max_before = l1_max;

@@ -46,6 +46,12 @@
 // body) or the disk exceeds `max_part_area` of the surface. Proposals are returned as Disk part
 // pairs (ranked by disagreement) that a person can accept, edit, or pass back.
 //
+// Quality gate (reject_worse_parts): a glued part is kept only if it adds no self-intersecting
+// triangle pair and no flipped face and does not increase the aligned error of the level's
+// landmark pairs (generated farthest-point pairs for same connectivity); otherwise the part
+// keeps its previous shape and its report says why. So the result never has more folds than
+// level 1, and level 1's own folds are reported.
+//
 // Folds: fold_report() counts self-intersecting triangle pairs (spatial/self_intersections.h)
 // of the reference, the source and a result, and locally flipped faces of the result against
 // the source (metrics/transfer_metrics.h).
@@ -77,6 +83,10 @@ struct PartTransferOptions {
   int min_part_vertices = 2000;  // subdivide a part while it has fewer vertices than this
   int max_subdivisions = 2;      // paper: "once or twice"; 0 = never
   int seam_rings = 3;            // edges on each side of a cut that the gluing step smooths (≥ 1)
+  // Keep a glued part only when it adds no self-intersecting triangle pair and no flipped face
+  // and does not move the level's landmark pairs away from the reference (aligned error); a
+  // rejected part keeps the previous level's shape and says why in its report.
+  bool reject_worse_parts = true;
   // Automatic proposals.
   int max_parts = 4;             // at most this many proposed parts (one level)
   double min_disagreement = 15;  // propose only where the disagreement exceeds this (degrees; see header)
@@ -86,6 +96,8 @@ struct PartTransferOptions {
   double neck_window_end = 1.5;    // high-disagreement region's geodesic extent from the tip
   double neck_ratio = 2.0;       // isoline perimeter growth (× narrowest so far) that marks the body
   double max_part_area = 0.3;    // a proposed part covers at most this fraction of the surface
+  double min_part_fraction = 0.03; // ... and at least this fraction of the vertices
+  double max_registration_degrees = 45; // larger local-frame rotations are not applied (see .cpp)
 };
 
 struct FoldReport {
@@ -118,6 +130,12 @@ struct PartReport {
   double ms = 0;                 // wall time of this part
   PoseTransferTimings transfer_ms; // of its Transfer I
   double glue_ms = 0;            // registration and gluing (editor precompute + solves)
+  // Quality gate (PartTransferOptions::reject_worse_parts): the level's landmark pairs' aligned
+  // error (metrics/transfer_metrics.h) before and after gluing this part, and the self-
+  // intersecting pairs and flipped faces the part added; rejected parts keep the previous shape.
+  double landmark_error_before = 0, landmark_error_after = 0;
+  int self_intersections_added = 0, flips_added = 0;
+  bool rejected = false;
 };
 
 struct PartTransferResult {
