@@ -616,7 +616,13 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     rep.flips_added = flips_after - flips_current;
     if (opt.reject_worse_parts) {
       std::string why;
-      if (si_after > si_current) why += ", adds " + std::to_string(si_after - si_current) + " self-intersecting pairs";
+      // Issue 16's bound: no more self-intersecting pairs than the reference and the source
+      // together (the Sumner poses themselves have 40–1565: limbs pressed against the body).
+      const int si_bound = std::max(si_current, out.folds_level1.self_intersections_reference +
+                                                    out.folds_level1.self_intersections_source);
+      if (si_after > si_bound)
+        why += ", adds " + std::to_string(si_after - si_current) + " self-intersecting pairs (bound " +
+               std::to_string(si_bound) + ")";
       if (flips_after > flips_current) why += ", adds " + std::to_string(flips_after - flips_current) + " flipped faces";
       if (rep.landmark_error_after > rep.landmark_error_before) why += ", moves the landmarks away from the reference";
       if (!why.empty()) {

@@ -46,11 +46,12 @@
 // body) or the disk exceeds `max_part_area` of the surface. Proposals are returned as Disk part
 // pairs (ranked by disagreement) that a person can accept, edit, or pass back.
 //
-// Quality gate (reject_worse_parts): a glued part is kept only if it adds no self-intersecting
-// triangle pair and no flipped face and does not increase the aligned error of the level's
-// landmark pairs (generated farthest-point pairs for same connectivity); otherwise the part
-// keeps its previous shape and its report says why. So the result never has more folds than
-// level 1, and level 1's own folds are reported.
+// Quality gate (reject_worse_parts): a glued part is kept only if the result keeps within the
+// fold bound (self-intersecting pairs ≤ max(reference + source, count before the part)), adds
+// no flipped face and does not increase the aligned error of the level's landmark pairs
+// (generated farthest-point pairs for same connectivity); otherwise the part keeps its previous
+// shape and its report says why. So the parts never add flips, nor self-intersections beyond
+// the bound; level 1's own folds are reported (folds_level1).
 //
 // Folds: fold_report() counts self-intersecting triangle pairs (spatial/self_intersections.h)
 // of the reference, the source and a result, and locally flipped faces of the result against
@@ -83,9 +84,11 @@ struct PartTransferOptions {
   int min_part_vertices = 2000;  // subdivide a part while it has fewer vertices than this
   int max_subdivisions = 2;      // paper: "once or twice"; 0 = never
   int seam_rings = 3;            // edges on each side of a cut that the gluing step smooths (≥ 1)
-  // Keep a glued part only when it adds no self-intersecting triangle pair and no flipped face
-  // and does not move the level's landmark pairs away from the reference (aligned error); a
-  // rejected part keeps the previous level's shape and says why in its report.
+  // Keep a glued part only when the result stays within issue 16's fold bound (no more
+  // self-intersecting pairs than the reference and the source together, or than before the
+  // part when level 1 already exceeds it), adds no flipped face, and does not move the level's
+  // landmark pairs away from the reference (aligned error); a rejected part keeps the previous
+  // shape and says why in its report.
   bool reject_worse_parts = true;
   // Automatic proposals.
   int max_parts = 4;             // at most this many proposed parts (one level)
