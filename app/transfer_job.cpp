@@ -57,7 +57,7 @@ const OptionSchema<PartTransferOptions>& transfer_part_options() {
               "edge rings on each side of a cut smoothed when a part is glued back");
     s.integer("max_parts", [](O& o) -> int& { return o.max_parts; }, 0, 64, "--parts auto: at most this many parts");
     s.number("min_disagreement", [](O& o) -> double& { return o.min_disagreement; }, 0, kUnbounded,
-             "--parts auto: propose parts only where the pose disagreement exceeds this × bbox diagonal");
+             "--parts auto: propose parts only where the pose disagreement exceeds this (degrees of local rotation; different connectivity: landmark distance in 1/180 of the diagonal)");
     s.number("neck_ratio", [](O& o) -> double& { return o.neck_ratio; }, 1, kUnbounded,
              "--parts auto: isoline perimeter growth that marks where a limb meets the body");
     s.number("max_part_area", [](O& o) -> double& { return o.max_part_area; }, 0, 1,

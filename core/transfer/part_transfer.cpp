@@ -236,17 +236,17 @@ std::vector<LandmarkPair> part_landmarks(const PartMesh& R, const PartMesh& S, c
     for (int v : ls) cs += S.V.row(v);
     cr /= lr.size();
     cs /= ls.size();
+    // Both loops follow their faces' orientation, so they run the same way around the cut: match
+    // the first sample by position (loops centred), then step both by equal arc fractions.
     const int samples = 6;
-    for (int k = 0; k < samples; ++k) {
-      const int s = ls[(ls.size() * k) / samples];
-      int best = -1;
-      double bd = std::numeric_limits<double>::infinity();
-      for (int r : lr) {
-        const double dd = ((R.V.row(r) - cr) - (S.V.row(s) - cs)).squaredNorm();
-        if (dd < bd) bd = dd, best = r;
-      }
-      add(best, s);
+    int r0 = 0;
+    double bd = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < lr.size(); ++i) {
+      const double dd = ((R.V.row(lr[i]) - cr) - (S.V.row(ls[0]) - cs)).squaredNorm();
+      if (dd < bd) bd = dd, r0 = static_cast<int>(i);
     }
+    for (int k = 0; k < samples; ++k)
+      add(lr[(r0 + lr.size() * k / samples) % lr.size()], ls[(ls.size() * k) / samples]);
   }
   return out;
 }
