@@ -153,8 +153,10 @@ std::string transfer_summary(const TransferJobResult& r, const PoseTransferOptio
                 t.ms.eigenbases, t.ms.coupling, t.ms.cage, t.ms.mvc, t.ms.optimisation, t.ms.total);
   s += buf;
   if (r.hierarchical) {
-    std::snprintf(buf, sizeof buf, "  parts: %zu transferred in %.0f ms (level 1 %.0f ms, total %.0f ms)\n",
-                  r.parts.reports.size(), r.parts.ms_parts, r.parts.ms_level1, r.parts.ms_total);
+    size_t kept = 0;
+    for (const PartReport& p : r.parts.reports) kept += p.status.ok();
+    std::snprintf(buf, sizeof buf, "  parts: %zu part pairs, %zu kept, in %.0f ms (level 1 %.0f ms, total %.0f ms)\n",
+                  r.parts.reports.size(), kept, r.parts.ms_parts, r.parts.ms_level1, r.parts.ms_total);
     s += buf;
     for (const PartReport& p : r.parts.reports) {
       std::snprintf(buf, sizeof buf,
