@@ -67,6 +67,14 @@ const OptionSchema<PartTransferOptions>& transfer_part_options() {
   return schema;
 }
 
+namespace {
+TransferJobResult transfer_job_failure(Status s) {
+  TransferJobResult r;
+  r.status = std::move(s);
+  return r;
+}
+}  // namespace
+
 TransferJobResult run_transfer_job(const TransferJobFiles& files, const PoseTransferOptions& options,
                                    const Progress& progress) {
   return run_transfer_job(files, options, PartTransferOptions{}, progress);
@@ -75,36 +83,36 @@ TransferJobResult run_transfer_job(const TransferJobFiles& files, const PoseTran
 TransferJobResult run_transfer_job(const TransferJobFiles& files, const PoseTransferOptions& options,
                                    const PartTransferOptions& part_options, const Progress& progress) {
   TransferJobResult r;
-  if (Status s = io::check_output_path(files.out); !s.ok()) return {s};
+  if (Status s = io::check_output_path(files.out); !s.ok()) return transfer_job_failure(s);
   if (!files.cage_out.empty())
-    if (Status s = io::check_output_path(files.cage_out); !s.ok()) return {s};
+    if (Status s = io::check_output_path(files.cage_out); !s.ok()) return transfer_job_failure(s);
   if (!files.parts_out.empty())
-    if (Status s = io::check_output_path(files.parts_out); !s.ok()) return {s};
+    if (Status s = io::check_output_path(files.parts_out); !s.ok()) return transfer_job_failure(s);
   PartsSpec spec;
   const bool auto_parts = files.parts == "auto";
   if (!files.parts.empty() && !auto_parts)
-    if (Status s = io::read_parts(files.parts, &spec); !s.ok()) return {s};
+    if (Status s = io::read_parts(files.parts, &spec); !s.ok()) return transfer_job_failure(s);
   if (!files.parts.empty() && options.method != TransferMethod::Yin)
-    return {Status::error(StatusCode::InvalidArgument, "--parts needs --method yin (the paper's method)")};
+    return transfer_job_failure(Status::error(StatusCode::InvalidArgument, "--parts needs --method yin (the paper's method)"));
   const io::LoadResult ref = io::load_asset(files.reference);
-  if (!ref.status.ok()) return {ref.status};
+  if (!ref.status.ok()) return transfer_job_failure(ref.status);
   const io::LoadResult src = io::load_asset(files.source);
-  if (!src.status.ok()) return {src.status};
+  if (!src.status.ok()) return transfer_job_failure(src.status);
   std::vector<LandmarkPair> pairs;
   if (!files.landmarks.empty())
-    if (Status s = io::read_landmarks(files.landmarks, &pairs); !s.ok()) return {s};
+    if (Status s = io::read_landmarks(files.landmarks, &pairs); !s.ok()) return transfer_job_failure(s);
   r.landmark_pairs = static_cast<int>(pairs.size());
   Mesh cage;
   if (!files.cage.empty()) {
     const io::LoadResult c = io::load_asset(files.cage);
-    if (!c.status.ok()) return {c.status};
+    if (!c.status.ok()) return transfer_job_failure(c.status);
     cage = c.asset.mesh();
   }
   const Mesh reference = ref.asset.mesh(), source = src.asset.mesh();
   Eigen::MatrixXd result;
   if (!files.parts.empty()) {
     if (!files.cage.empty())
-      return {Status::error(StatusCode::InvalidArgument, "--cage is not supported with --parts (each part gets its own cage)")};
+      return transfer_job_failure(Status::error(StatusCode::InvalidArgument, "--cage is not supported with --parts (each part gets its own cage)"));
     PartTransferOptions po = part_options;
     po.transfer = options;
     r.parts = part_transfer(reference, source, pairs, auto_parts ? nullptr : &spec, po, progress);
