@@ -41,10 +41,13 @@
 // units of 1/180 of the diagonal ("degrees") so one threshold serves both. From the worst
 // vertex's region a tip is taken (the high-disagreement vertex farthest from the centroid, or
 // the landmark itself), and a geodesic disk around it is grown to a neck: along the geodesic
-// isolines from the tip, the cut is at the narrowest isoline (shortest perimeter) in a window
-// past the high-disagreement region and before the isoline perimeter jumps (the limb meets the
-// body) or the disk exceeds `max_part_area` of the surface. Proposals are returned as Disk part
-// pairs (ranked by disagreement) that a person can accept, edit, or pass back.
+// isolines from the tip, the cut is at the narrowest isoline (shortest perimeter; the latest
+// within 10% of it) between `neck_window_begin` and `neck_window_end` times the high-disagreement
+// region's geodesic extent from the tip, and before the isoline perimeter grows past
+// `neck_ratio` × the narrowest so far (the limb meets the body) or the disk exceeds
+// `max_part_area` of the surface; disks under `min_part_fraction` of the vertices are dropped.
+// Proposals are returned as Disk part pairs (ranked by disagreement) that a person can accept,
+// edit, or pass back. Experimental: measured on the Sumner/TOSCA pairs only (docs/transfer.md).
 //
 // Quality gate (reject_worse_parts): a glued part is kept only if the result keeps within the
 // fold bound (self-intersecting pairs ≤ max(reference + source, count before the part)), adds
