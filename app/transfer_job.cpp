@@ -4,6 +4,7 @@
 
 #include "io/asset.h"
 #include "io/landmarks_file.h"
+#include "io/parts_file.h"
 
 namespace mm::app {
 
@@ -42,30 +43,102 @@ const OptionSchema<PoseTransferOptions>& transfer_options() {
   return schema;
 }
 
+const OptionSchema<PartTransferOptions>& transfer_part_options() {
+  using O = PartTransferOptions;
+  static const OptionSchema<O> schema = [] {
+    OptionSchema<O> s("transfer parts", "hierarchical part transfer (paper 000 Sec. 4.3), with --parts");
+    s.integer("part_cage_vertices", [](O& o) -> int& { return o.part_cage_vertices; }, 8, 100000,
+              "size of each part's automatic cage");
+    s.integer("min_part_vertices", [](O& o) -> int& { return o.min_part_vertices; }, 0, 10000000,
+              "butterfly-subdivide a part while it has fewer vertices than this");
+    s.integer("max_subdivisions", [](O& o) -> int& { return o.max_subdivisions; }, 0, 3,
+              "at most this many butterfly levels per part (paper: once or twice)");
+    s.integer("seam_rings", [](O& o) -> int& { return o.seam_rings; }, 1, 50,
+              "edge rings on each side of a cut smoothed when a part is glued back");
+    s.integer("max_parts", [](O& o) -> int& { return o.max_parts; }, 0, 64, "--parts auto: at most this many parts");
+    s.number("min_disagreement", [](O& o) -> double& { return o.min_disagreement; }, 0, kUnbounded,
+             "--parts auto: propose parts only where the pose disagreement exceeds this (degrees of local rotation; different connectivity: landmark distance in 1/180 of the diagonal)");
+    s.number("neck_ratio", [](O& o) -> double& { return o.neck_ratio; }, 1, kUnbounded,
+             "--parts auto: isoline perimeter growth that marks where a limb meets the body");
+    s.number("max_part_area", [](O& o) -> double& { return o.max_part_area; }, 0, 1,
+             "--parts auto: largest part, as a fraction of the surface area");
+    return s;
+  }();
+  return schema;
+}
+
+namespace {
+TransferJobResult transfer_job_failure(Status s) {
+  TransferJobResult r;
+  r.status = std::move(s);
+  return r;
+}
+}  // namespace
+
 TransferJobResult run_transfer_job(const TransferJobFiles& files, const PoseTransferOptions& options,
                                    const Progress& progress) {
+  return run_transfer_job(files, options, PartTransferOptions{}, progress);
+}
+
+TransferJobResult run_transfer_job(const TransferJobFiles& files, const PoseTransferOptions& options,
+                                   const PartTransferOptions& part_options, const Progress& progress) {
   TransferJobResult r;
-  if (Status s = io::check_output_path(files.out); !s.ok()) return {s};
+  if (Status s = io::check_output_path(files.out); !s.ok()) return transfer_job_failure(s);
   if (!files.cage_out.empty())
-    if (Status s = io::check_output_path(files.cage_out); !s.ok()) return {s};
+    if (Status s = io::check_output_path(files.cage_out); !s.ok()) return transfer_job_failure(s);
+  if (!files.parts_out.empty())
+    if (Status s = io::check_output_path(files.parts_out); !s.ok()) return transfer_job_failure(s);
+  PartsSpec spec;
+  const bool auto_parts = files.parts == "auto";
+  if (!files.parts.empty() && !auto_parts)
+    if (Status s = io::read_parts(files.parts, &spec); !s.ok()) return transfer_job_failure(s);
+  if (!files.parts.empty() && options.method != TransferMethod::Yin)
+    return transfer_job_failure(Status::error(StatusCode::InvalidArgument, "--parts needs --method yin (the paper's method)"));
   const io::LoadResult ref = io::load_asset(files.reference);
-  if (!ref.status.ok()) return {ref.status};
+  if (!ref.status.ok()) return transfer_job_failure(ref.status);
   const io::LoadResult src = io::load_asset(files.source);
-  if (!src.status.ok()) return {src.status};
+  if (!src.status.ok()) return transfer_job_failure(src.status);
   std::vector<LandmarkPair> pairs;
   if (!files.landmarks.empty())
-    if (Status s = io::read_landmarks(files.landmarks, &pairs); !s.ok()) return {s};
+    if (Status s = io::read_landmarks(files.landmarks, &pairs); !s.ok()) return transfer_job_failure(s);
   r.landmark_pairs = static_cast<int>(pairs.size());
   Mesh cage;
   if (!files.cage.empty()) {
     const io::LoadResult c = io::load_asset(files.cage);
-    if (!c.status.ok()) return {c.status};
+    if (!c.status.ok()) return transfer_job_failure(c.status);
     cage = c.asset.mesh();
   }
-  r.transfer = pose_transfer(ref.asset.mesh(), src.asset.mesh(), pairs, options, progress,
-                             files.cage.empty() ? nullptr : &cage);
-  if (!(r.status = r.transfer.status).ok()) return r;
-  if (!(r.status = io::save_asset(src.asset, r.transfer.V, files.out)).ok()) return r;
+  const Mesh reference = ref.asset.mesh(), source = src.asset.mesh();
+  Eigen::MatrixXd result;
+  if (!files.parts.empty()) {
+    if (!files.cage.empty())
+      return transfer_job_failure(Status::error(StatusCode::InvalidArgument, "--cage is not supported with --parts (each part gets its own cage)"));
+    PartTransferOptions po = part_options;
+    po.transfer = options;
+    r.parts = part_transfer(reference, source, pairs, auto_parts ? nullptr : &spec, po, progress);
+    if (!(r.status = r.parts.status).ok()) return r;
+    r.hierarchical = true;
+    r.transfer = r.parts.level1;
+    r.folds = r.parts.folds;
+    result = r.parts.V;
+  } else {
+    r.transfer = pose_transfer(reference, source, pairs, options, progress, files.cage.empty() ? nullptr : &cage);
+    if (!(r.status = r.transfer.status).ok()) return r;
+    result = r.transfer.V;
+    r.folds = fold_report(reference, source, result);
+    if (!files.parts_out.empty()) {
+      PartTransferOptions po = part_options;
+      po.transfer = options;
+      r.parts.parts = propose_parts(reference, source, result, r.transfer.landmarks, po, &r.parts.disagreement);
+    }
+  }
+  if (!(r.status = io::save_asset(src.asset, result, files.out)).ok()) return r;
+  if (!files.parts_out.empty())
+    if (!(r.status = io::write_parts(files.parts_out, r.parts.parts,
+                                     "part pairs of meshmorph transfer: reference " + files.reference + ", source " +
+                                         files.source))
+             .ok())
+      return r;
   if (!files.cage_out.empty() && r.transfer.cage_deformed.rows() > 0)
     r.status = io::save_mesh(files.cage_out, r.transfer.cage_deformed, r.transfer.cage_faces);
   return r;
@@ -86,6 +159,33 @@ std::string transfer_summary(const TransferJobResult& r, const PoseTransferOptio
   std::snprintf(buf, sizeof buf,
                 "\n  time: eigenbases %.0f ms, coupling %.0f ms, cage %.0f ms, MVC %.0f ms, optimisation %.0f ms, total %.0f ms\n",
                 t.ms.eigenbases, t.ms.coupling, t.ms.cage, t.ms.mvc, t.ms.optimisation, t.ms.total);
+  s += buf;
+  if (r.hierarchical) {
+    size_t kept = 0;
+    for (const PartReport& p : r.parts.reports) kept += p.status.ok();
+    std::snprintf(buf, sizeof buf, "  parts: %zu part pairs, %zu kept, in %.0f ms (level 1 %.0f ms, total %.0f ms)\n",
+                  r.parts.reports.size(), kept, r.parts.ms_parts, r.parts.ms_level1, r.parts.ms_total);
+    s += buf;
+    for (const PartReport& p : r.parts.reports) {
+      std::snprintf(buf, sizeof buf,
+                    "    level %d %s: %d / %d vertices, %d subdivisions, %d landmarks, rotation %.1f°, seam dihedral change mean %.1f° max %.1f°, %.0f ms%s%s\n",
+                    p.level, p.name.empty() ? "(unnamed)" : p.name.c_str(), p.source_vertices, p.reference_vertices,
+                    p.subdivisions, p.landmarks, p.rotation_degrees, p.seam_dihedral_mean, p.seam_dihedral_max, p.ms,
+                    p.status.ok() ? "" : ", skipped: ", p.status.ok() ? "" : p.status.message.c_str());
+      s += buf;
+    }
+    std::snprintf(buf, sizeof buf, "  level 1: %d self-intersecting triangle pairs, %d flipped faces\n",
+                  r.parts.folds_level1.self_intersections_result, r.parts.folds_level1.flipped_faces);
+    s += buf;
+  } else if (!r.parts.parts.parts.empty()) {
+    std::snprintf(buf, sizeof buf, "  proposed %zu part pairs\n", r.parts.parts.parts.size());
+    s += buf;
+  }
+  const FoldReport& f = r.folds;
+  std::snprintf(buf, sizeof buf,
+                "  folds: %d self-intersecting triangle pairs (reference %d, source %d)%s, %d flipped faces\n",
+                f.self_intersections_result, f.self_intersections_reference, f.self_intersections_source,
+                f.new_folds() ? " — more than the inputs together" : "", f.flipped_faces);
   return s + buf;
 }
 

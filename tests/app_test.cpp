@@ -43,6 +43,7 @@ void expect_schema_consistent(const app::OptionSchema<O>& schema) {
 
 TEST(OptionSchema, EveryJobIsConsistent) {
   expect_schema_consistent(app::transfer_options());
+  expect_schema_consistent(app::transfer_part_options());
   expect_schema_consistent(app::edit_options());
   expect_schema_consistent(app::retarget_options());
 }

@@ -11,6 +11,17 @@
 //        gammaDominance, iterations, converged, couplingIterations, cagePositions: Float64Array,
 //        cageRest: Float64Array, cageIndices: Uint32Array, energy: Float64Array,
 //        ms: {eigenbases, coupling, cage, mvc, optimisation, total}}
+//   partTransfer(refPositions, refIndices, srcPositions, srcIndices, landmarks, parts, options?,
+//                partOptions?, progress?)   hierarchical part transfer (paper 000 Sec. 4.3, issue 16)
+//     parts: "auto" (proposed parts) or the text of a part file (core/io/parts_file.h)
+//     options: the transfer schema's keys; partOptions: optionSchema("transfer parts")
+//     → {ok, positions: Float64Array (#V·3, final), positionsLevel1: Float64Array (#V·3),
+//        partsJson: the part pairs used (part-file text, e.g. the proposals to edit),
+//        parts: [{name, level, ok, message, sourceVertices, referenceVertices, subdivisions,
+//                 landmarks, rotationDegrees, seamDihedralMean, seamDihedralMax, rejected, ms}],
+//        folds: {reference, source, level1, result, flipsLevel1, flips} (self-intersecting
+//                triangle pairs; flipped faces against the source),
+//        ms: {level1, parts, total}}
 //   transferMetrics(positionsA (#V·3), positionsB (#V·3), indices (#F·3))
 //     → {ok, vertexErrorMean, vertexErrorMax, laplacianChange, edgeDistortionMean,
 //        edgeDistortionMax, flippedFaces}
@@ -23,6 +34,7 @@
 #include "convert.h"
 #include "metrics/transfer_metrics.h"
 #include "app/transfer_job.h"
+#include "io/parts_file.h"
 #include "guard.h"
 
 namespace mm::wasm {
@@ -73,6 +85,66 @@ val pose_transfer_js(val ref_positions, val ref_indices, val src_positions, val 
   }
 }
 
+val part_transfer_js(val ref_positions, val ref_indices, val src_positions, val src_indices, val landmarks, val parts,
+                     val options, val part_options, val progress) {
+  const Mesh ref{to_matrix(ref_positions), to_index_matrix(ref_indices)};
+  const Mesh src{to_matrix(src_positions), to_index_matrix(src_indices)};
+  const std::vector<int> flat = to_int_vector(landmarks);
+  if (flat.size() % 2 != 0)
+    return status_object(Status::error(StatusCode::InvalidArgument, "landmarks must hold pairs (reference, source)"));
+  std::vector<LandmarkPair> pairs;
+  for (size_t i = 0; i + 1 < flat.size(); i += 2) pairs.push_back({flat[i], flat[i + 1]});
+  PartTransferOptions opt;
+  if (Status os = read_options(options, app::transfer_options(), &opt.transfer); !os.ok()) return status_object(os);
+  if (Status os = read_options(part_options, app::transfer_part_options(), &opt); !os.ok()) return status_object(os);
+  if (!parts.isString())
+    return status_object(Status::error(StatusCode::InvalidArgument, "parts must be \"auto\" or the text of a part file"));
+  const std::string parts_text = parts.as<std::string>();
+  PartsSpec spec;
+  const bool automatic = parts_text == "auto";
+  if (!automatic)
+    if (Status ps = io::parse_parts(parts_text, "parts", &spec); !ps.ok()) return status_object(ps);
+  const PartTransferResult r = part_transfer(ref, src, pairs, automatic ? nullptr : &spec, opt, js_progress(progress));
+  val out = status_object(r.status);
+  if (!r.status.ok()) return out;
+  out.set("positions", to_float64_array(r.V));
+  out.set("positionsLevel1", to_float64_array(r.V_level1));
+  out.set("partsJson", io::parts_json(r.parts));
+  val list = val::array();
+  for (const PartReport& p : r.reports) {
+    val o = val::object();
+    o.set("name", p.name);
+    o.set("level", p.level);
+    o.set("ok", p.status.ok());
+    o.set("message", p.status.message);
+    o.set("sourceVertices", p.source_vertices);
+    o.set("referenceVertices", p.reference_vertices);
+    o.set("subdivisions", p.subdivisions);
+    o.set("landmarks", p.landmarks);
+    o.set("rotationDegrees", p.rotation_degrees);
+    o.set("seamDihedralMean", p.seam_dihedral_mean);
+    o.set("seamDihedralMax", p.seam_dihedral_max);
+    o.set("rejected", p.rejected);
+    o.set("ms", p.ms);
+    list.call<void>("push", o);
+  }
+  out.set("parts", list);
+  val folds = val::object();
+  folds.set("reference", r.folds.self_intersections_reference);
+  folds.set("source", r.folds.self_intersections_source);
+  folds.set("level1", r.folds_level1.self_intersections_result);
+  folds.set("result", r.folds.self_intersections_result);
+  folds.set("flipsLevel1", r.folds_level1.flipped_faces);
+  folds.set("flips", r.folds.flipped_faces);
+  out.set("folds", folds);
+  val ms = val::object();
+  ms.set("level1", r.ms_level1);
+  ms.set("parts", r.ms_parts);
+  ms.set("total", r.ms_total);
+  out.set("ms", ms);
+  return out;
+}
+
 val transfer_metrics_js(val a, val b, val indices) {
   const TransferMetrics m = transfer_metrics(to_matrix(a), to_matrix(b), to_index_matrix(indices));
   val out = status_object(m.status);
@@ -90,6 +162,7 @@ val transfer_metrics_js(val a, val b, val indices) {
 
 EMSCRIPTEN_BINDINGS(meshmorph_transfer) {
   bind<&pose_transfer_js>("poseTransfer");
+  bind<&part_transfer_js>("partTransfer");
   bind<&transfer_metrics_js>("transferMetrics");
 }
 

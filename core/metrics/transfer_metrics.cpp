@@ -1,6 +1,7 @@
 #include "metrics/transfer_metrics.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <map>
 #include <utility>
@@ -8,6 +9,7 @@
 
 #include <Eigen/Geometry>
 
+#include "linalg/rigid_fit.h"
 #include "mesh/mesh.h"
 #include "mesh/topology.h"
 
@@ -92,6 +94,17 @@ TransferMetrics transfer_metrics(const Eigen::MatrixXd& A, const Eigen::MatrixXd
   for (int f = 0; f < F.rows(); ++f)
     if (agree_a[f] < 0 && agree_b[f] > 0.5) ++out.flipped_faces;
   return out;
+}
+
+double aligned_vertex_error(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
+  assert(A.rows() == B.rows() && A.cols() == 3 && B.cols() == 3 && "aligned_vertex_error: A and B differ in shape");
+  if (A.rows() == 0) return 0;
+  RigidFitOptions o;
+  o.scale = true;
+  const RigidFit fit = fit_rigid(A, B, o);
+  const Eigen::MatrixXd aligned = ((fit.s * A * fit.R.transpose()).rowwise() + fit.t.transpose());
+  const double D = bounding_box_diagonal(B);
+  return (aligned - B).rowwise().norm().mean() / (D > 0 ? D : 1.0);
 }
 
 }  // namespace mm

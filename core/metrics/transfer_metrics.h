@@ -31,4 +31,10 @@ struct TransferMetrics {
 
 TransferMetrics transfer_metrics(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXi& F);
 
+// Aligned vertex error: mean_i |s R a_i + t − b_i| / D (D = bbox diagonal of B) after the
+// least-squares similarity (Umeyama, linalg/rigid_fit.h) of A onto B, so that a global
+// placement, orientation or size difference (e.g. a result kept at the source's size) does not
+// count. A and B: #V by 3, same vertex order (assert).
+double aligned_vertex_error(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B);
+
 }  // namespace mm

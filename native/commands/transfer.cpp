@@ -20,6 +20,9 @@ const char* kTransferUsage =
     "                       required when the meshes have different connectivity\n"
     "  --cage C             closed cage around the source (default: automatic)\n"
     "  --cage-out FILE      also write the deformed cage\n"
+    "  --parts P.json|auto  hierarchical part transfer (paper 000 Sec. 4.3): part pairs from a file\n"
+    "                       (core/io/parts_file.h) or proposed where the pose disagrees most\n"
+    "  --parts-out FILE     write the part pairs used (without --parts: the proposals)\n"
     "options (app/transfer_job.h):\n";
 
 int run_transfer(const std::vector<std::string>& argv) {
@@ -28,7 +31,7 @@ int run_transfer(const std::vector<std::string>& argv) {
   Status s = args.parse(argv, {"help"});
   if (!s.ok()) return cli::report("transfer", s);
   if (args.has("help")) {
-    std::cout << kTransferUsage << schema.help();
+    std::cout << kTransferUsage << schema.help() << "part options (with --parts):\n" << app::transfer_part_options().help();
     return 0;
   }
   if (!args.has("reference") || !args.has("source") || !args.has("out")) {
@@ -37,6 +40,8 @@ int run_transfer(const std::vector<std::string>& argv) {
   }
   PoseTransferOptions opt;
   if (!(s = cli::read_options(args, schema, &opt)).ok()) return cli::report("transfer", s);
+  PartTransferOptions part_opt;
+  if (!(s = cli::read_options(args, app::transfer_part_options(), &part_opt)).ok()) return cli::report("transfer", s);
   app::TransferJobFiles files;
   files.reference = args.get("reference");
   files.source = args.get("source");
@@ -44,8 +49,10 @@ int run_transfer(const std::vector<std::string>& argv) {
   files.landmarks = args.get("landmarks");
   files.cage = args.get("cage");
   files.cage_out = args.get("cage-out");
+  files.parts = args.get("parts");
+  files.parts_out = args.get("parts-out");
   if (!(s = cli::check_unused(args)).ok()) return cli::report("transfer", s);
-  const app::TransferJobResult r = app::run_transfer_job(files, opt, cli::terminal_progress());
+  const app::TransferJobResult r = app::run_transfer_job(files, opt, part_opt, cli::terminal_progress());
   if (!r.status.ok()) return cli::report("transfer", r.status);
   std::printf("%swrote %s\n", app::transfer_summary(r, opt).c_str(), files.out.c_str());
   return 0;

@@ -63,6 +63,19 @@ test('the wasm bindings reject options the schema does not know, naming them', a
   assert.match(range.message, /cage_vertices/);
 });
 
+test('partTransfer rejects unknown part options and malformed part files before any work', async () => {
+  const module = await loadModule();
+  const tri = new Float64Array([0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1]);
+  const idx = new Uint32Array([0, 1, 2, 0, 3, 1, 0, 2, 3, 1, 3, 2]);
+  const r = module.partTransfer(tri, idx, tri, idx, new Int32Array(0), 'auto', {}, { seam_ringz: 2 }, undefined);
+  assert.equal(r.ok, false);
+  assert.equal(r.code, 'InvalidArgument');
+  assert.match(r.message, /seam_ringz/);
+  const bad = module.partTransfer(tri, idx, tri, idx, new Int32Array(0), '{"parts": 3}', {}, {}, undefined);
+  assert.equal(bad.ok, false);
+  assert.equal(bad.code, 'ParseError');
+});
+
 test('the worker op optionSchema returns the schema the bindings use', async () => {
   const { ops } = await import('../../web/src/worker/ops/mesh.js');
   const { makeContext } = await import('./wasm_module.mjs');

@@ -142,6 +142,10 @@ export type Op = (ctx: OpContext, options: object, buffers: Buffers) => { buffer
 // suggestLandmarks {referenceSlot?, sourceSlot?, count? = 8, sameConnectivity?}
 //          → {} / {pairs: [[r, s, cost]] (welded), reference, source: {centre, radius,
 //            extremities: [{vertex, relative, direction}], between}}
+// partTransfer: a binding only so far (wasm/bind_transfer.cpp, hierarchical part transfer, issue
+//          16), no worker op or panel yet: (reference, source as welded arrays, landmarks, parts =
+//          "auto" | part-file text, transfer options, part options, progress) → {positions,
+//          positionsLevel1, partsJson, parts, folds, ms}
 // ---- edit ops (ops/edit.js): positions results carry {positions, rawPositions, rawNormals}
 // ---- debug ops (ops/debug.js; the e2e recovery checks only)
 // debugExhaustMemory {} → {} / {allocatedMB};  debugCrash {} → the worker dies after answering

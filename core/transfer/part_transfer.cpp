@@ -1,0 +1,665 @@
+#include "transfer/part_transfer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <functional>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include <Eigen/Geometry>
+
+#include "linalg/rigid_fit.h"
+#include "merge/cut.h"
+#include "mesh/butterfly.h"
+#include "mesh/topology.h"
+#include "metrics/transfer_metrics.h"
+#include "operators/operators.h"
+#include "spatial/self_intersections.h"
+
+namespace mm {
+
+namespace part_detail {
+
+double part_ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// A part as a submesh: faces of F with all three vertices in the set, compacted.
+struct PartMesh {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  std::vector<int> from;      // submesh vertex → mesh vertex
+  std::vector<int> boundary;  // submesh vertices on its boundary loops (the cut), ascending
+  int tip = -1;               // submesh vertex farthest (along edges) from the boundary
+};
+
+PartMesh part_submesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const std::vector<int>& set) {
+  std::vector<char> in(V.rows(), 0);
+  for (int v : set) in[v] = 1;
+  std::vector<int> faces;
+  for (int f = 0; f < F.rows(); ++f)
+    if (in[F(f, 0)] && in[F(f, 1)] && in[F(f, 2)]) faces.push_back(f);
+  Eigen::MatrixXi Fs(static_cast<Eigen::Index>(faces.size()), 3);
+  for (size_t k = 0; k < faces.size(); ++k) Fs.row(static_cast<Eigen::Index>(k)) = F.row(faces[k]);
+  PartMesh p;
+  compact_mesh(V, Fs, &p.V, &p.F, &p.from);
+  const int n = static_cast<int>(p.V.rows());
+  if (n == 0) return p;
+  for (const auto& loop : boundary_loops(p.F, n))
+    for (int v : loop) p.boundary.push_back(v);
+  std::sort(p.boundary.begin(), p.boundary.end());
+  p.boundary.erase(std::unique(p.boundary.begin(), p.boundary.end()), p.boundary.end());
+  if (!p.boundary.empty()) {
+    const auto adj = vertex_adjacency(p.F, n);
+    std::vector<double> d(n, std::numeric_limits<double>::infinity());
+    for (int b : p.boundary) relax_edge_distances(p.V, adj, b, &d);
+    double best = -1;
+    for (int v = 0; v < n; ++v)
+      if (std::isfinite(d[v]) && d[v] > best) best = d[v], p.tip = v;
+  }
+  return p;
+}
+
+// Local frame of Sec. 4.3 (columns e1, e2, e3) from the average point o of the submesh, the
+// average b of its cut-boundary vertices and the point f farthest from the boundary: e1 along
+// b → f, e2 the part of b → o orthogonal to it. *axis_only when o lies on the axis (a straight
+// limb): then only e1 is meaningful.
+Eigen::Matrix3d part_frame(const Eigen::MatrixXd& P, const std::vector<int>& boundary, int tip, bool* axis_only) {
+  const Eigen::Vector3d o = P.colwise().mean().transpose();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (int v : boundary) b += P.row(v).transpose();
+  b /= std::max<size_t>(1, boundary.size());
+  const Eigen::Vector3d f = P.row(tip).transpose();
+  Eigen::Vector3d e1 = f - b;
+  const double len = e1.norm();
+  e1 = len > 0 ? Eigen::Vector3d(e1 / len) : Eigen::Vector3d::UnitX();
+  Eigen::Vector3d e2 = (o - b) - (o - b).dot(e1) * e1;
+  *axis_only = !(e2.norm() > 0.05 * std::max(len, (o - b).norm()));
+  if (*axis_only) e2 = e1.unitOrthogonal();
+  e2.normalize();
+  Eigen::Matrix3d E;
+  E.col(0) = e1;
+  E.col(1) = e2;
+  E.col(2) = e1.cross(e2);
+  return E;
+}
+
+Eigen::Vector3d part_boundary_centroid(const Eigen::MatrixXd& P, const std::vector<int>& boundary) {
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (int v : boundary) b += P.row(v).transpose();
+  return b / std::max<size_t>(1, boundary.size());
+}
+
+bool part_regions_equal(const PartRegion& a, const PartRegion& b) {
+  if (a.kind != b.kind) return false;
+  switch (a.kind) {
+    case PartRegionKind::Disk: return a.seed == b.seed && a.radius == b.radius;
+    case PartRegionKind::Plane: return a.point == b.point && a.normal == b.normal && a.keep == b.keep;
+    case PartRegionKind::Vertices: return a.vertices == b.vertices;
+  }
+  return false;
+}
+
+// Dihedral angle change (degrees) across the edges that join a part to the rest of the mesh:
+// |θ_A(e) − θ_B(e)| with θ the angle between the two face normals; mean and max over those edges.
+void part_seam_dihedral(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXi& F,
+                        const std::vector<char>& in_part, double* mean, double* max) {
+  const Eigen::MatrixXd NA = face_normals(A, F), NB = face_normals(B, F);
+  std::vector<std::pair<std::pair<int, int>, int>> uses;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      if (in_part[a] != in_part[b]) uses.push_back({{std::min(a, b), std::max(a, b)}, f});
+    }
+  std::sort(uses.begin(), uses.end());
+  double sum = 0, mx = 0;
+  int count = 0;
+  for (size_t i = 0; i + 1 < uses.size(); ++i) {
+    if (uses[i].first != uses[i + 1].first) continue;
+    if (i + 2 < uses.size() && uses[i + 2].first == uses[i].first) continue;  // non-manifold edge
+    const int f = uses[i].second, g = uses[i + 1].second;
+    auto angle = [](const Eigen::RowVector3d& n1, const Eigen::RowVector3d& n2) {
+      return std::atan2(n1.cross(n2).norm(), n1.dot(n2)) * 180.0 / M_PI;
+    };
+    const double d = std::abs(angle(NA.row(f), NA.row(g)) - angle(NB.row(f), NB.row(g)));
+    sum += d;
+    mx = std::max(mx, d);
+    ++count;
+  }
+  *mean = count > 0 ? sum / count : 0;
+  *max = mx;
+}
+
+// Isoline perimeters of the geodesic distance from `tip` and the radius of the narrowest neck
+// (see header): 0 when no cut fits between `r_min`, `r_max` (0 = no bound) and the area cap.
+double part_neck_radius(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                        const std::vector<std::vector<int>>& adj, int tip, double r_min, double r_max,
+                        const PartTransferOptions& opt) {
+  const int n = static_cast<int>(V.rows());
+  std::vector<double> d(n, std::numeric_limits<double>::infinity());
+  relax_edge_distances(V, adj, tip, &d);
+  double dmax = 0;
+  for (double x : d)
+    if (std::isfinite(x)) dmax = std::max(dmax, x);
+  if (!(dmax > 0)) return 0;
+  const int N = 160;
+  std::vector<double> perim(N, 0), area(N, 0);
+  double total = 0;
+  auto level = [&](int k) { return dmax * (k + 1) / (N + 1); };
+  for (int f = 0; f < F.rows(); ++f) {
+    const int i0 = F(f, 0), i1 = F(f, 1), i2 = F(f, 2);
+    if (!std::isfinite(d[i0]) || !std::isfinite(d[i1]) || !std::isfinite(d[i2])) continue;
+    const Eigen::Vector3d p[3] = {V.row(i0).transpose(), V.row(i1).transpose(), V.row(i2).transpose()};
+    const double dv[3] = {d[i0], d[i1], d[i2]};
+    const double fa = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+    total += fa;
+    const double lo = std::min({dv[0], dv[1], dv[2]}), hi = std::max({dv[0], dv[1], dv[2]});
+    // Area inside level k: the whole face once its farthest corner is inside.
+    const int k_in = static_cast<int>(std::ceil(hi * (N + 1) / dmax)) - 1;
+    if (k_in < N) area[std::max(0, k_in)] += fa;
+    for (int k = std::max(0, static_cast<int>(std::floor(lo * (N + 1) / dmax)) - 1); k < N; ++k) {
+      const double t = level(k);
+      if (t >= hi) break;
+      if (t <= lo) continue;
+      Eigen::Vector3d pts[2];
+      int m = 0;
+      for (int e = 0; e < 3 && m < 2; ++e) {
+        const double a = dv[e], b = dv[(e + 1) % 3];
+        if ((a < t) != (b < t)) {
+          const double s = (t - a) / (b - a);
+          pts[m++] = p[e] + s * (p[(e + 1) % 3] - p[e]);
+        }
+      }
+      if (m == 2) perim[k] += (pts[0] - pts[1]).norm();
+    }
+  }
+  for (int k = 1; k < N; ++k) area[k] += area[k - 1];
+  int k_lo = -1, k_hi = -1;
+  for (int k = 0; k < N; ++k) {
+    if (area[k] > opt.max_part_area * total || (r_max > 0 && level(k) > r_max)) break;
+    k_hi = k;
+    if (k_lo < 0 && level(k) >= r_min && area[k] >= 0.01 * total && perim[k] > 0) k_lo = k;
+  }
+  if (k_lo < 0 || k_hi < k_lo) return 0;
+  // The window ends where the isoline grows past neck_ratio × the narrowest one so far.
+  int k_end = k_hi;
+  double m = perim[k_lo];
+  for (int k = k_lo; k <= k_hi; ++k) {
+    m = std::min(m, perim[k]);
+    if (perim[k] > opt.neck_ratio * m) {
+      k_end = k - 1;
+      break;
+    }
+  }
+  // Narrowest isoline in the window; the latest of those within 10% of it (closest to the body).
+  double best = std::numeric_limits<double>::infinity();
+  for (int k = k_lo; k <= k_end; ++k) best = std::min(best, perim[k]);
+  int k_cut = k_lo;
+  for (int k = k_lo; k <= k_end; ++k)
+    if (perim[k] <= 1.1 * best) k_cut = k;
+  return level(k_cut);
+}
+
+// Landmarks of a different-connectivity part pair (header, step 3): pairs inside both parts,
+// the tips, and 6 samples of the cut loops matched by position after centring the loops.
+std::vector<LandmarkPair> part_landmarks(const PartMesh& R, const PartMesh& S, const std::vector<LandmarkPair>& level,
+                                         int n_ref, int n_src) {
+  std::vector<int> rmap(n_ref, -1), smap(n_src, -1);
+  for (int i = 0; i < static_cast<int>(R.from.size()); ++i) rmap[R.from[i]] = i;
+  for (int i = 0; i < static_cast<int>(S.from.size()); ++i) smap[S.from[i]] = i;
+  std::vector<LandmarkPair> out;
+  std::vector<char> used_r(R.V.rows(), 0), used_s(S.V.rows(), 0);
+  auto add = [&](int r, int s) {
+    if (r < 0 || s < 0 || used_r[r] || used_s[s]) return;
+    used_r[r] = used_s[s] = 1;
+    out.push_back({r, s});
+  };
+  for (const LandmarkPair& p : level)
+    if (p.reference >= 0 && p.reference < n_ref && p.source >= 0 && p.source < n_src)
+      add(rmap[p.reference], smap[p.source]);
+  add(R.tip, S.tip);
+  const auto rl = boundary_loops(R.F, static_cast<int>(R.V.rows()));
+  const auto sl = boundary_loops(S.F, static_cast<int>(S.V.rows()));
+  auto largest = [](const std::vector<std::vector<int>>& loops) {
+    size_t best = 0;
+    for (size_t i = 1; i < loops.size(); ++i)
+      if (loops[i].size() > loops[best].size()) best = i;
+    return best;
+  };
+  if (!rl.empty() && !sl.empty()) {
+    const auto& lr = rl[largest(rl)];
+    const auto& ls = sl[largest(sl)];
+    Eigen::RowVector3d cr = Eigen::RowVector3d::Zero(), cs = Eigen::RowVector3d::Zero();
+    for (int v : lr) cr += R.V.row(v);
+    for (int v : ls) cs += S.V.row(v);
+    cr /= lr.size();
+    cs /= ls.size();
+    // Both loops follow their faces' orientation, so they run the same way around the cut: match
+    // the first sample by position (loops centred), then step both by equal arc fractions.
+    const int samples = 6;
+    int r0 = 0;
+    double bd = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < lr.size(); ++i) {
+      const double dd = ((R.V.row(lr[i]) - cr) - (S.V.row(ls[0]) - cs)).squaredNorm();
+      if (dd < bd) bd = dd, r0 = static_cast<int>(i);
+    }
+    for (int k = 0; k < samples; ++k)
+      add(lr[(r0 + lr.size() * k / samples) % lr.size()], ls[(ls.size() * k) / samples]);
+  }
+  return out;
+}
+
+}  // namespace part_detail
+
+using namespace part_detail;
+
+FoldReport fold_report(const Mesh& reference, const Mesh& source, const Eigen::MatrixXd& result) {
+  FoldReport r;
+  r.self_intersections_reference = self_intersections(reference.V, reference.F).pairs;
+  r.self_intersections_source = self_intersections(source.V, source.F).pairs;
+  r.self_intersections_result = self_intersections(result, source.F).pairs;
+  r.flipped_faces = transfer_metrics(result, source.V, source.F).flipped_faces;
+  return r;
+}
+
+Status part_vertices(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const PartRegion& region,
+                     std::vector<int>* vertices) {
+  vertices->clear();
+  const int n = static_cast<int>(V.rows());
+  switch (region.kind) {
+    case PartRegionKind::Vertices:
+      for (int v : region.vertices) {
+        if (v < 0 || v >= n)
+          return Status::error(StatusCode::InvalidArgument, "part vertex " + std::to_string(v) +
+                                                                " is out of range (the mesh has " + std::to_string(n) +
+                                                                " vertices)");
+        vertices->push_back(v);
+      }
+      break;
+    case PartRegionKind::Disk: {
+      if (region.seed < 0 || region.seed >= n)
+        return Status::error(StatusCode::InvalidArgument, "part seed vertex " + std::to_string(region.seed) +
+                                                              " is out of range (the mesh has " + std::to_string(n) +
+                                                              " vertices)");
+      if (!(region.radius > 0) || !std::isfinite(region.radius))
+        return Status::error(StatusCode::InvalidArgument, "part disk radius must be > 0 (fraction of the diagonal)");
+      // The part is what cut_disk removes: every vertex the kept piece no longer references.
+      const CutResult c = cut_disk(V, F, region.seed, region.radius * bounding_box_diagonal(V));
+      if (!c.status.ok()) return Status::error(StatusCode::InvalidArgument, "part disk: " + c.status.message);
+      std::vector<char> kept(n, 0);
+      for (int v : c.from)
+        if (v >= 0) kept[v] = 1;
+      for (int v = 0; v < n; ++v)
+        if (!kept[v]) vertices->push_back(v);
+      break;
+    }
+    case PartRegionKind::Plane: {
+      PlaneCutOptions po;
+      po.snap_fraction = 0;  // keep vertex positions: the part is a vertex set of the input
+      const CutResult c = cut_plane(V, F, region.point, region.normal, region.keep, po);
+      if (!c.status.ok()) return Status::error(StatusCode::InvalidArgument, "part plane: " + c.status.message);
+      for (int v : c.from)
+        if (v >= 0) vertices->push_back(v);
+      break;
+    }
+  }
+  std::sort(vertices->begin(), vertices->end());
+  vertices->erase(std::unique(vertices->begin(), vertices->end()), vertices->end());
+  if (vertices->empty()) return Status::error(StatusCode::InvalidArgument, "the part region selects no vertex");
+  if (static_cast<int>(vertices->size()) >= n)
+    return Status::error(StatusCode::InvalidArgument, "the part region selects the whole mesh");
+  return Status::success();
+}
+
+PartsSpec propose_parts(const Mesh& reference, const Mesh& source, const Eigen::MatrixXd& transferred,
+                        const std::vector<LandmarkPair>& landmarks, const PartTransferOptions& opt,
+                        std::vector<double>* disagreement) {
+  PartsSpec spec;
+  const int n = static_cast<int>(source.V.rows());
+  const bool same = reference.num_vertices() == source.num_vertices() && reference.F == source.F;
+  const double diag_ref = bounding_box_diagonal(reference.V);
+  const double diag_src = bounding_box_diagonal(source.V);
+  std::vector<double> d(n, 0.0);
+  RigidFitOptions fo;
+  fo.scale = true;
+  const auto adj_s = vertex_adjacency(source.F, n);
+  if (same) {
+    // Local pose disagreement: the rotation angle (degrees) of the best rigid fit of each
+    // vertex's `disagreement_rings`-ring from the (globally aligned) level-1 result onto the
+    // reference. A limb the low frequencies left mis-oriented rotates as a whole, so the angle is
+    // high along all of it and falls off at its joint, where the cut belongs.
+    const RigidFit fit = fit_rigid(transferred, reference.V, fo);
+    const Eigen::MatrixXd aligned = (fit.s * transferred * fit.R.transpose()).rowwise() + fit.t.transpose();
+    for (int i = 0; i < n; ++i) {
+      const std::vector<int> ring = k_ring(adj_s, i, opt.disagreement_rings);
+      if (ring.size() < 4) continue;
+      Eigen::MatrixXd A(ring.size(), 3), B(ring.size(), 3);
+      for (size_t k = 0; k < ring.size(); ++k) {
+        A.row(static_cast<Eigen::Index>(k)) = aligned.row(ring[k]);
+        B.row(static_cast<Eigen::Index>(k)) = reference.V.row(ring[k]);
+      }
+      RigidFitOptions ro;
+      ro.min_spread = 0.05;  // a nearly collinear ring has no well-defined rotation
+      const RigidFit local = fit_rigid(A, B, ro);
+      d[i] = local.degenerate ? 0.0 : Eigen::AngleAxisd(local.R).angle() * 180.0 / M_PI;
+    }
+    // Two passes of 1-ring averaging: single vertices with an ill-conditioned ring (a flat ear
+    // tip can flip its best rotation by 180°) do not become seeds.
+    for (int pass = 0; pass < 2; ++pass) {
+      std::vector<double> sm(n, 0.0);
+      for (int i = 0; i < n; ++i) {
+        double sum = d[i];
+        for (int w : adj_s[i]) sum += d[w];
+        sm[i] = sum / (1 + adj_s[i].size());
+      }
+      d.swap(sm);
+    }
+  } else if (!landmarks.empty()) {
+    // Only the landmark pairs correspond: their distance after a similarity fit, in degrees of
+    // the same scale (1 degree per 1/180 of the diagonal) so that one threshold serves both.
+    Eigen::MatrixXd P(landmarks.size(), 3), Q(landmarks.size(), 3);
+    for (size_t k = 0; k < landmarks.size(); ++k) {
+      P.row(static_cast<Eigen::Index>(k)) = transferred.row(landmarks[k].source);
+      Q.row(static_cast<Eigen::Index>(k)) = reference.V.row(landmarks[k].reference);
+    }
+    const RigidFit fit = fit_rigid(P, Q, fo);
+    for (size_t k = 0; k < landmarks.size(); ++k)
+      d[landmarks[k].source] = 180.0 * (fit.s * fit.R * P.row(static_cast<Eigen::Index>(k)).transpose() + fit.t -
+                                        Q.row(static_cast<Eigen::Index>(k)).transpose()).norm() / diag_ref;
+  }
+  if (disagreement) *disagreement = d;
+  const auto adj_r = same ? std::vector<std::vector<int>>{} : vertex_adjacency(reference.F, reference.num_vertices());
+  const Eigen::VectorXd a = mass_diagonal(source.V, source.F);
+  const Eigen::RowVector3d centroid = (a.transpose() * source.V) / std::max(a.sum(), 1e-300);
+  std::vector<char> taken(n, 0);
+  for (int p = 0; p < opt.max_parts; ++p) {
+    int worst = -1;
+    for (int i = 0; i < n; ++i)
+      if (!taken[i] && (worst < 0 || d[i] > d[worst])) worst = i;
+    if (worst < 0 || !(d[worst] >= opt.min_disagreement)) break;
+    // Tip and the geodesic extent of the high-disagreement region.
+    int tip = worst, tip_ref = -1;
+    std::vector<int> blob{worst};
+    if (same) {
+      std::vector<char> seen(n, 0);
+      seen[worst] = 1;
+      for (size_t q = 0; q < blob.size(); ++q)
+        for (int w : adj_s[blob[q]])
+          if (!seen[w] && !taken[w] && d[w] >= opt.blob_fraction * d[worst]) {
+            seen[w] = 1;
+            blob.push_back(w);
+          }
+      double far = -1;
+      for (int v : blob) {
+        const double r = (source.V.row(v) - centroid).norm();
+        if (r > far) far = r, tip = v;
+      }
+      tip_ref = tip;
+    } else {
+      for (const LandmarkPair& l : landmarks)
+        if (l.source == worst) tip_ref = l.reference;
+    }
+    double r_blob = 0;
+    std::vector<double> dt(n, std::numeric_limits<double>::infinity());
+    relax_edge_distances(source.V, adj_s, tip, &dt);
+    for (int v : blob) r_blob = std::max(r_blob, dt[v]);
+    const double radius = part_neck_radius(source.V, source.F, adj_s, tip, opt.neck_window_begin * r_blob,
+                                           opt.neck_window_end * r_blob, opt);
+    // Mark the region (and what the disk would cover) taken either way, so the next proposal
+    // looks elsewhere.
+    for (int v : blob) taken[v] = 1;
+    for (int v = 0; v < n; ++v)
+      if (dt[v] < std::max(radius, r_blob) * 1.15) taken[v] = 1;
+    if (!(radius > 0) || tip_ref < 0) continue;
+    int inside = 0;
+    for (int v = 0; v < n; ++v) inside += dt[v] < radius;
+    if (inside < opt.min_part_fraction * n) continue;  // too small to carry a pose of its own
+    PartPair pp;
+    char name[96];
+    std::snprintf(name, sizeof name, "auto %d (disagreement %.3f at vertex %d)", p + 1, d[worst], worst);
+    pp.name = name;
+    pp.source.kind = PartRegionKind::Disk;
+    pp.source.seed = tip;
+    pp.source.radius = radius / diag_src;
+    if (same) {
+      pp.reference = pp.source;
+    } else {
+      const double rr = part_neck_radius(reference.V, reference.F, adj_r, tip_ref, 0, 0, opt);
+      if (!(rr > 0)) continue;
+      pp.reference.kind = PartRegionKind::Disk;
+      pp.reference.seed = tip_ref;
+      pp.reference.radius = rr / diag_ref;
+    }
+    spec.parts.push_back(std::move(pp));
+  }
+  return spec;
+}
+
+PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, const std::vector<LandmarkPair>& landmarks,
+                                 const PartsSpec* spec, const PartTransferOptions& opt, const Progress& progress) {
+  using clock = std::chrono::steady_clock;
+  const auto t_start = clock::now();
+  PartTransferResult out;
+  if (opt.seam_rings < 1 || opt.min_part_vertices < 0 || opt.max_subdivisions < 0 || opt.max_subdivisions > 3) {
+    out.status = Status::error(StatusCode::InvalidArgument,
+                               "part transfer: need seam_rings >= 1, min_part_vertices >= 0, max_subdivisions in 0..3");
+    return out;
+  }
+  // Level 1: the whole body.
+  out.level1 = pose_transfer(reference, source, landmarks, opt.transfer, progress.sub(0.0, 0.4));
+  out.ms_level1 = part_ms_since(t_start);
+  if (!(out.status = out.level1.status).ok()) return out;
+  out.V_level1 = out.level1.V;
+  Eigen::MatrixXd Vcur = out.V_level1;
+  out.folds_level1 = fold_report(reference, source, Vcur);
+  const auto t_parts = clock::now();
+  if (!progress.update("part proposals", 0.42)) {
+    out.status = cancelled_status("part proposals");
+    return out;
+  }
+  if (spec) out.parts = *spec;
+  else out.parts = propose_parts(reference, source, Vcur, out.level1.landmarks, opt, &out.disagreement);
+
+  const int nS = source.num_vertices(), nR = reference.num_vertices();
+  const bool same_conn = nS == nR && reference.F == source.F;
+  const auto adj_full = vertex_adjacency(source.F, nS);
+  std::function<int(const std::vector<PartPair>&)> count_parts = [&](const std::vector<PartPair>& l) {
+    int c = 0;
+    for (const PartPair& p : l) c += 1 + count_parts(p.children);
+    return c;
+  };
+  const int total_parts = count_parts(out.parts.parts);
+  int done = 0;
+  // Running fold counts of Vcur and the level's landmark error (quality gate, see transfer_part).
+  int si_current = out.folds_level1.self_intersections_result;
+  int flips_current = out.folds_level1.flipped_faces;
+  const std::vector<LandmarkPair>& level_pairs = out.level1.landmarks;
+  Eigen::MatrixXd lm_ref(level_pairs.size(), 3);
+  for (size_t k = 0; k < level_pairs.size(); ++k)
+    lm_ref.row(static_cast<Eigen::Index>(k)) = reference.V.row(level_pairs[k].reference);
+  auto lm_error = [&](const Eigen::MatrixXd& X) {
+    Eigen::MatrixXd lm(level_pairs.size(), 3);
+    for (size_t k = 0; k < level_pairs.size(); ++k) lm.row(static_cast<Eigen::Index>(k)) = X.row(level_pairs[k].source);
+    return aligned_vertex_error(lm, lm_ref);
+  };
+
+  // One part pair (header, steps 1–5) on the current result Vcur.
+  auto transfer_part = [&](const PartPair& pp, int level) -> Status {
+    const auto t0 = clock::now();
+    PartReport rep;
+    rep.name = pp.name;
+    rep.level = level;
+    const Progress pp_progress = progress.sub(0.45 + 0.55 * done / std::max(1, total_parts),
+                                              0.45 + 0.55 * (done + 1) / std::max(1, total_parts));
+    ++done;
+    std::vector<int> sset, rset;
+    if (Status s = part_vertices(source.V, source.F, pp.source, &sset); !s.ok())
+      return Status::error(s.code, "part \"" + pp.name + "\" (source): " + s.message);
+    if (same_conn && part_regions_equal(pp.source, pp.reference)) {
+      rset = sset;
+    } else if (Status s = part_vertices(reference.V, reference.F, pp.reference, &rset); !s.ok()) {
+      return Status::error(s.code, "part \"" + pp.name + "\" (reference): " + s.message);
+    }
+    PartMesh S = part_submesh(Vcur, source.F, sset);
+    PartMesh R = part_submesh(reference.V, reference.F, rset);
+    rep.source_vertices = static_cast<int>(S.V.rows());
+    rep.reference_vertices = static_cast<int>(R.V.rows());
+    auto skip = [&](Status s) {
+      rep.status = s;
+      rep.ms = part_ms_since(t0);
+      out.reports.push_back(rep);
+      return Status::success();
+    };
+    if (S.boundary.empty() || R.boundary.empty() || S.tip < 0 || R.tip < 0)
+      return skip(Status::error(StatusCode::InvalidMesh, "the part has no cut boundary (it is a closed piece)"));
+    // Step 2: butterfly subdivision of both parts by the same number of levels.
+    const int n_min = static_cast<int>(std::min(S.V.rows(), R.V.rows()));
+    int levels = 0;
+    for (long size = n_min; levels < opt.max_subdivisions && size < opt.min_part_vertices; size *= 4) ++levels;
+    rep.subdivisions = levels;
+    const ButterflyResult Ssub = butterfly_subdivide(S.V, S.F, levels);
+    const ButterflyResult Rsub = butterfly_subdivide(R.V, R.F, levels);
+    // Step 3: Transfer I on the pair.
+    std::vector<LandmarkPair> lm;
+    const bool same_pair = S.F.rows() == R.F.rows() && S.F == R.F;
+    if (same_pair) R.tip = S.tip;  // one frame construction for both (the distances differ slightly by pose)
+    else lm = part_landmarks(R, S, landmarks, nR, nS);
+    PoseTransferOptions topt = opt.transfer;
+    topt.cage.target_vertices = opt.part_cage_vertices;
+    topt.cage.resolution = opt.part_cage_resolution;
+    topt.placement = TransferPlacement::Reference;
+    Mesh Sm{Ssub.V, Ssub.F}, Rm{Rsub.V, Rsub.F};
+    const PoseTransferResult t = pose_transfer(Rm, Sm, lm, topt, pp_progress.sub(0.0, 0.8));
+    if (t.status.code == StatusCode::Cancelled) return t.status;
+    rep.landmarks = static_cast<int>(t.landmarks.size());
+    rep.transfer_ms = t.ms;
+    if (!t.status.ok()) return skip(t.status);
+    const auto t_glue = clock::now();
+    Eigen::MatrixXd T;
+    Eigen::MatrixXi Fc;
+    butterfly_coarsen(t.V, Ssub.F, levels, static_cast<int>(S.V.rows()), &T, &Fc);
+    // Step 4: registration by local frames, rotation about the boundary centroid, then the
+    // boundary centroid onto the level-1 one.
+    bool axis_t = false, axis_r = false;
+    const Eigen::Matrix3d Et = part_frame(T, S.boundary, S.tip, &axis_t);
+    const Eigen::Matrix3d Er = part_frame(R.V, R.boundary, R.tip, &axis_r);
+    Eigen::Matrix3d Rot;
+    if (axis_t || axis_r) Rot = Eigen::Quaterniond::FromTwoVectors(Et.col(0), Er.col(0)).toRotationMatrix();
+    else Rot = Er * Et.transpose();
+    rep.rotation_degrees = Eigen::AngleAxisd(Rot).angle() * 180.0 / M_PI;
+    // Transfer I already gives the part the reference part's orientation (the low frequencies
+    // carry it), so a large frame rotation means an ill-conditioned frame (a short or straight
+    // part whose average point lies near the axis): measured up to 167° on cat-07/cat-05 parts,
+    // all rejected by the gate below. Such rotations are not applied.
+    if (rep.rotation_degrees > opt.max_registration_degrees) Rot.setIdentity();
+    const Eigen::Vector3d bt = part_boundary_centroid(T, S.boundary);
+    const Eigen::Vector3d bs = part_boundary_centroid(S.V, S.boundary);
+    Eigen::MatrixXd Treg(T.rows(), 3);
+    for (int i = 0; i < T.rows(); ++i) Treg.row(i) = (Rot * (T.row(i).transpose() - bt) + bs).transpose();
+    // Step 5: gluing. Free: `seam_rings` rings around the cut on both sides; handle: the
+    // part's other vertices at their registered positions; the rest of the mesh stays.
+    std::vector<char> in_part(nS, 0);
+    for (int v : sset) in_part[v] = 1;
+    std::vector<int> cut;
+    for (int b : S.boundary) cut.push_back(S.from[b]);
+    std::vector<int> band;
+    std::vector<int> handle;
+    for (int rings = opt.seam_rings; rings >= 1; --rings) {
+      band = k_ring(adj_full, cut, rings);
+      std::vector<char> in_band(nS, 0);
+      for (int v : band) in_band[v] = 1;
+      handle.clear();
+      for (int i = 0; i < static_cast<int>(S.from.size()); ++i)
+        if (!in_band[S.from[i]]) handle.push_back(S.from[i]);
+      if (!handle.empty()) break;
+    }
+    if (handle.empty()) return skip(Status::error(StatusCode::InvalidMesh, "the part is too small for its seam band"));
+    std::sort(handle.begin(), handle.end());
+    EditRegion region;
+    region.handles = {handle};
+    std::vector<char> in_handle(nS, 0);
+    for (int v : handle) in_handle[v] = 1;
+    for (int v : band)
+      if (!in_handle[v]) region.roi.push_back(v);
+    for (int v : sset)  // part vertices outside the submesh (no full face) move with the seam
+      if (!in_handle[v]) region.roi.push_back(v);
+    std::sort(region.roi.begin(), region.roi.end());
+    region.roi.erase(std::unique(region.roi.begin(), region.roi.end()), region.roi.end());
+    rep.seam_vertices = static_cast<int>(region.roi.size());
+    for (int v : handle) region.roi.push_back(v);
+    std::sort(region.roi.begin(), region.roi.end());
+    LaplacianEditOptions eo;
+    eo.handle_basis = false;
+    LaplacianEditor editor;
+    Eigen::MatrixXd targets = Vcur;
+    for (int i = 0; i < static_cast<int>(S.from.size()); ++i) targets.row(S.from[i]) = Treg.row(i);
+    double l1_mean = 0, l1_max = 0;
+    part_seam_dihedral(Vcur, source.V, source.F, in_part, &l1_mean, &l1_max);
+    if (Status s = editor.precompute(Vcur, source.F, region, eo, pp_progress.sub(0.8, 0.95)); !s.ok()) {
+      if (s.code == StatusCode::Cancelled) return s;
+      return skip(Status::error(s.code, "gluing: " + s.message));
+    }
+    EditResult d = editor.drag_positions(targets);
+    if (!d.status.ok()) return skip(Status::error(d.status.code, "gluing: " + d.status.message));
+    EditResult fin = editor.finalize(FeatureSize::Keep);
+    if (!fin.status.ok()) return skip(Status::error(fin.status.code, "gluing: " + fin.status.message));
+    if (!fin.V.allFinite()) return skip(Status::error(StatusCode::NumericalError, "gluing produced non-finite positions"));
+    // Quality gate: keep the part only if it brings the level's landmark pairs closer to the
+    // reference (after a similarity fit) and adds no self-intersection and no flipped face.
+    const int si_after = self_intersections(fin.V, source.F).pairs;
+    const int flips_after = transfer_metrics(fin.V, source.V, source.F).flipped_faces;
+    rep.landmark_error_before = lm_error(Vcur);
+    rep.landmark_error_after = lm_error(fin.V);
+    rep.self_intersections_added = si_after - si_current;
+    rep.flips_added = flips_after - flips_current;
+    if (opt.reject_worse_parts) {
+      std::string why;
+      // Issue 16's bound: no more self-intersecting pairs than the reference and the source
+      // together (the Sumner poses themselves have 40–1565: limbs pressed against the body).
+      const int si_bound = std::max(si_current, out.folds_level1.self_intersections_reference +
+                                                    out.folds_level1.self_intersections_source);
+      if (si_after > si_bound)
+        why += ", adds " + std::to_string(si_after - si_current) + " self-intersecting pairs (bound " +
+               std::to_string(si_bound) + ")";
+      if (flips_after > flips_current) why += ", adds " + std::to_string(flips_after - flips_current) + " flipped faces";
+      if (rep.landmark_error_after > rep.landmark_error_before) why += ", moves the landmarks away from the reference";
+      if (!why.empty()) {
+        rep.rejected = true;
+        return skip(Status::error(StatusCode::NotConverged, "rejected: the glued part" + why.substr(1)));
+      }
+    }
+    si_current = si_after;
+    flips_current = flips_after;
+    part_seam_dihedral(fin.V, source.V, source.F, in_part, &rep.seam_dihedral_mean, &rep.seam_dihedral_max);
+    rep.seam_dihedral_mean_before = l1_mean;
+    rep.seam_dihedral_max_before = l1_max;
+    Vcur = fin.V;
+    rep.glue_ms = part_ms_since(t_glue);
+    rep.ms = part_ms_since(t0);
+    out.reports.push_back(rep);
+    return Status::success();
+  };
+  std::function<Status(const std::vector<PartPair>&, int)> run_level = [&](const std::vector<PartPair>& list,
+                                                                          int level) -> Status {
+    for (const PartPair& pp : list) {
+      if (Status s = transfer_part(pp, level); !s.ok()) return s;
+      if (!pp.children.empty())
+        if (Status s = run_level(pp.children, level + 1); !s.ok()) return s;
+    }
+    return Status::success();
+  };
+  if (Status s = run_level(out.parts.parts, 2); !s.ok()) {
+    out.status = s;
+    return out;
+  }
+  out.V = Vcur;
+  out.ms_parts = part_ms_since(t_parts);
+  out.folds = fold_report(reference, source, out.V);
+  out.ms_total = part_ms_since(t_start);
+  progress.update("done", 1.0);
+  return out;
+}
+
+}  // namespace mm
