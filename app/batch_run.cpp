@@ -98,7 +98,7 @@ void close_fd(int* fd) {
   *fd = -1;
 }
 
-bool write_all(int fd, const std::string& s) {
+bool batch_run_write_all(int fd, const std::string& s) {
   size_t done = 0;
   while (done < s.size()) {
     const ssize_t w = ::write(fd, s.data() + done, s.size() - done);
@@ -437,7 +437,7 @@ BatchRunResult run_batch(const BatchManifest& m, const BatchRunOptions& opt, con
         w.job = j;
         w.fraction = 0;
         w.started = Clock::now();
-        if (!write_all(w.in, batch_job_message(m.jobs[static_cast<size_t>(j)]))) ::kill(w.pid, SIGKILL);  // reported at EOF
+        if (!batch_run_write_all(w.in, batch_job_message(m.jobs[static_cast<size_t>(j)]))) ::kill(w.pid, SIGKILL);  // reported at EOF
       }
       // Idle workers with nothing left to do: close their input, they exit.
       if (queue.size() == 0)
