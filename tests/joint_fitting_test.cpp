@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -121,6 +122,14 @@ void jf_print(const std::string& what, const JfError& e, const mm::JointFitResul
             << fit.target_skeleton.size() << ", limb ends " << fit.source_skeleton.leaves().size() << " / "
             << fit.target_skeleton.leaves().size() << " matched " << fit.limb_ends.size() << ", up "
             << fit.target_up << "\n";
+  if (std::getenv("MM_JF_DEBUG")) {  // limb ends, for looking into a failing fit
+    for (const mm::CurveSkeleton* sk : {&fit.source_skeleton, &fit.target_skeleton}) {
+      std::cout << "    leaves:";
+      for (int l : sk->leaves())
+        std::cout << " (" << sk->nodes(l, 0) << ", " << sk->nodes(l, 1) << ", " << sk->nodes(l, 2) << " r " << sk->radius[l] << ")";
+      std::cout << "\n";
+    }
+  }
 }
 
 }  // namespace
@@ -133,12 +142,15 @@ TEST(CurveSkeleton, TubeGivesAChainAlongItsAxis) {
   jf_tube(0.1, 1.0, 40, 24, &V, &F);
   const mm::CurveSkeleton s = mm::curve_skeleton(V, F);
   ASSERT_TRUE(s.status.ok()) << s.status.message;
+  if (std::getenv("MM_JF_DEBUG"))
+    for (int i = 0; i < s.size(); ++i)
+      std::cout << i << " parent " << s.parent[i] << " at " << s.nodes.row(i) << " r " << s.radius[i] << "\n";
   EXPECT_EQ(s.leaves().size(), 2u);
   const auto adj = s.adjacency();
   for (int i = 0; i < s.size(); ++i) EXPECT_LE(adj[i].size(), 2u) << "a tube has no branches";
   for (int i = 0; i < s.size(); ++i) {
     EXPECT_LT(std::hypot(s.nodes(i, 0), s.nodes(i, 2)), 0.03) << "node " << i << " off the axis";
-    EXPECT_NEAR(s.radius[i], 0.1, 0.04);
+    if (s.nodes(i, 1) > 0.2 && s.nodes(i, 1) < 0.8) EXPECT_NEAR(s.radius[i], 0.1, 0.02);
   }
   // The ends reach near the caps.
   EXPECT_LT(s.nodes.col(1).minCoeff(), 0.1);

@@ -409,10 +409,20 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
       const double len = reach[k] + (pos[k] - pos[c]).norm();
       if (len > longest) longest = len, keep = k;
     }
-    if (kids[c].size() >= 2 || (c == root && !kids[c].empty()))
-      for (int k : kids[c])
-        if (k != keep && reach[k] + (pos[k] - pos[c]).norm() < prune) kill(k);
-    reach[c] = std::max(0.0, longest);
+    // A side branch is pruned when shorter than prune_length or than the local radius (bumps,
+    // and the fragments a band's ring breaks into where a limb's cap is cut obliquely); the
+    // limb's own tip likewise when shorter than the radius (the node then ends the limb).
+    const double r_here = (rmax[c] + 0.5) * h;
+    double kept = 0;
+    for (int k : kids[c]) {
+      const double len = reach[k] + (pos[k] - pos[c]).norm();
+      const bool split = kids[c].size() >= 2, side = k != keep;
+      if (split && ((side && len < std::max(prune, opt.prune_radius * r_here)) || (!side && len < opt.prune_radius * r_here)))
+        kill(k);
+      else kept = std::max(kept, len);
+    }
+    (void)longest;
+    reach[c] = kept;
   }
   // The root's side branches: the root is usually mid-body, so its shortest remaining branch
   // can also be a stub; the rule above handles it as for any junction.
@@ -433,6 +443,77 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
     out.parent[new_id[c]] = c == root ? -1 : new_id[par[c]];
   }
   out.root = new_id[root];
+  // Limb tips: the last bands of a limb are rings on its cap whose centroids drift toward the
+  // cells the (discrete) geodesic reaches last, so the chain bends off the axis in its last
+  // radius. Each tip chain is cut back by one local radius and extended straight along the
+  // remaining chain's direction to where it leaves the solid.
+  {
+    const auto adj0 = out.adjacency();
+    std::vector<uint8_t> drop(m, 0);
+    for (int leaf = 0; leaf < m; ++leaf) {
+      if (adj0[leaf].size() != 1 || leaf == out.root) continue;
+      std::vector<int> chain = {leaf};
+      double arc = 0, rmax_chain = out.radius[leaf];
+      int a = leaf;
+      while (out.parent[a] >= 0 && adj0[out.parent[a]].size() == 2 && out.parent[a] != out.root) {
+        arc += (out.nodes.row(out.parent[a]) - out.nodes.row(a)).norm();
+        a = out.parent[a];
+        chain.push_back(a);
+        rmax_chain = std::max(rmax_chain, out.radius[a]);
+        if (arc >= rmax_chain) break;
+      }
+      if (chain.size() < 2 || arc < rmax_chain) continue;  // short tips are left as they are
+      // Direction from one more radius up the chain to the anchor a.
+      int b = a;
+      double back = 0;
+      while (out.parent[b] >= 0 && back < out.radius[a]) {
+        back += (out.nodes.row(out.parent[b]) - out.nodes.row(b)).norm();
+        b = out.parent[b];
+      }
+      Eigen::Vector3d d = (out.nodes.row(a) - out.nodes.row(b)).transpose();
+      if (d.norm() <= 0) continue;
+      d.normalize();
+      Eigen::Vector3d e = out.nodes.row(a).transpose();
+      for (int step = 0; step < 4 * opt.resolution && vs.contains(e + 0.5 * h * d); ++step) e += 0.5 * h * d;
+      for (size_t k = 1; k + 1 < chain.size(); ++k) drop[chain[k]] = 1;
+      out.nodes.row(leaf) = e.transpose();
+      out.radius[leaf] = 0.5 * h;
+      out.parent[leaf] = a;
+    }
+    // The first bands are concentric shells around the seed with (nearly) the same centroid: a
+    // root with a single child that close is dropped, and so on down the chain.
+    int new_root = out.root;
+    for (;;) {
+      std::vector<int> kids_of_root;
+      for (int i = 0; i < m; ++i)
+        if (out.parent[i] == new_root && !drop[i]) kids_of_root.push_back(i);
+      if (kids_of_root.size() != 1) break;
+      const int kid = kids_of_root[0];
+      if ((out.nodes.row(kid) - out.nodes.row(new_root)).norm() > 0.5 * out.radius[new_root]) break;
+      drop[new_root] = 1;
+      out.parent[kid] = -1;
+      new_root = kid;
+    }
+    out.root = new_root;
+    std::vector<int> id(m, -1);
+    int k = 0;
+    for (int i = 0; i < m; ++i)
+      if (!drop[i]) id[i] = k++;
+    Eigen::MatrixXd P(k, 3);
+    Eigen::VectorXd R(k);
+    std::vector<int> par2(k, -1);
+    for (int i = 0; i < m; ++i) {
+      if (drop[i]) continue;
+      P.row(id[i]) = out.nodes.row(i);
+      R[id[i]] = out.radius[i];
+      par2[id[i]] = out.parent[i] >= 0 ? id[out.parent[i]] : -1;
+    }
+    out.nodes = P;
+    out.radius = R;
+    out.parent = par2;
+    out.root = id[out.root];
+    m = k;
+  }
   // Smooth chain nodes (degree 2): removes the stair-steps of the band centroids.
   const auto adj = out.adjacency();
   for (int it = 0; it < opt.smoothing_iterations; ++it) {

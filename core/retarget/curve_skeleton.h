@@ -19,7 +19,8 @@
 //     boundary); each node's parent is the component of the previous band it touches most
 //     (the Reeb graph's tree: every component of band k > 0 touches band k − 1 because a
 //     Dijkstra step is ≤ √3 < band_width);
-//  5. leaf branches shorter than prune_length are removed, and chain nodes are smoothed.
+//  5. leaf branches shorter than prune_length or than the local radius are removed (salience as in
+//     Au et al. 2008's pruning of short branches), and chain nodes are smoothed.
 //
 // V #V by 3, F #F by 3 (any triangle soup). Status: InvalidMesh when the mesh is empty, has
 // non-finite coordinates or out-of-range indices, is flat, or gives too few solid cells;
@@ -42,7 +43,8 @@ struct CurveSkeletonOptions {
   int resolution = 96;          // grid cells along the longest bounding-box side, in [16, 512]
   double band_width = 2.0;      // geodesic band width in cells, ≥ √3 (see 4. above)
   int close_holes = 1;          // dilation/erosion radius in cells that closes holes in the surface (0 = none)
-  double prune_length = 0.05;   // leaf branches shorter than this × the longest side are removed
+  double prune_length = 0.05;   // side branches shorter than this × the longest side are removed
+  double prune_radius = 1.0;    // ... and leaf branches shorter than this × the radius where they start
   int smoothing_iterations = 3; // Laplacian smoothing passes over chain (degree-2) nodes
 };
 
