@@ -22,7 +22,9 @@ const OptionSchema<JointsJobOptions>& joints_options() {
     s.integer("source_up", [](O& o) -> int& { return o.fit.source_up; }, 0, 5,
               "source up axis: 0..2 = +x,+y,+z, 3..5 = -x,-y,-z (glTF: 1)");
     s.integer("target_up", [](O& o) -> int& { return o.fit.target_up; }, -1, 5,
-              "target up axis as source_up; -1 = detect (the end with most feet)");
+              "target up axis as source_up; -1 = +y for glTF, else detect (the end with most feet)");
+    s.integer("target_front", [](O& o) -> int& { return o.fit.target_front; }, -1, 5,
+              "target facing axis as source_up; -1 = +z for glTF, else detect");
     s.number("leaf_tolerance", [](O& o) -> double& { return o.fit.leaf_tolerance; }, 0, 10,
              "limb ends match when at most this × height apart");
     s.integer("marker_reach", [](O& o) -> int& { return o.fit.marker_reach; }, 0, 100,
@@ -82,8 +84,13 @@ JointsJobResult run_joints_job(const io::Asset& source, const io::Asset& target,
     if (!mr.status.ok()) return r.status = Status{mr.status.code, "markers: " + mr.status.message}, r;
     for (int i = 0; i < mr.joints.size(); ++i) markers.push_back({mr.joints.names[i], mr.joints.P.row(i).transpose()});
   }
+  JointFitOptions fo = opt.fit;
+  if (io::gltf_model(target) != nullptr) {  // glTF: +Y up, front +Z by its spec
+    if (fo.target_up < 0) fo.target_up = 1;
+    if (fo.target_front < 0 && fo.target_up % 3 != 2) fo.target_front = 2;
+  }
   r.fit = fit_joints(src.character.V_rest, src.character.F, character_joints(src.character), r.target_V, r.target_F,
-                     markers, opt.fit, progress);
+                     markers, fo, progress);
   if (!r.fit.status.ok()) return r.status = r.fit.status, r;
   for (auto& w : r.fit.warnings) r.warnings.push_back(w);
   r.json = joints_json_text(r.fit.joints);

@@ -92,8 +92,10 @@ Status RetargetJob::prepare(const io::Asset& source, const io::Asset& target, co
   }
   if (target_joints_json == "auto") {
     // Automatic joints (issue 14): the source's skeleton fitted inside the target.
-    JointFitResult fit = fit_joints(source_.V_rest, source_.F, character_joints(source_), target_V_, target_F_, {},
-                                    JointFitOptions{}, progress.sub(0, 0.3));
+    JointFitOptions fo;
+    if (target_is_gltf_) fo.target_up = 1, fo.target_front = 2;  // glTF: +Y up, front +Z by its spec
+    JointFitResult fit = fit_joints(source_.V_rest, source_.F, character_joints(source_), target_V_, target_F_, {}, fo,
+                                    progress.sub(0, 0.3));
     if (!fit.status.ok()) return Status{fit.status.code, "automatic target joints: " + fit.status.message};
     target_joints = std::move(fit.joints);
   } else if (!target_joints_json.empty()) {

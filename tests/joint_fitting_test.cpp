@@ -204,7 +204,10 @@ JfRun jf_fit_characters(const std::string& source, const std::string& target,
   JfRun run;
   const JfCharacter s = jf_character(source), t = jf_character(target);
   const auto t0 = std::chrono::steady_clock::now();
-  run.fit = mm::fit_joints(s.c.V_rest, s.c.F, s.joints, t.c.V_rest, t.c.F);
+  mm::JointFitOptions o;
+  o.target_up = 1;  // glTF targets: +Y up, +Z front by the spec (as the joints job sets)
+  o.target_front = 2;
+  run.fit = mm::fit_joints(s.c.V_rest, s.c.F, s.joints, t.c.V_rest, t.c.F, {}, o);
   run.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_TRUE(run.fit.status.ok()) << run.fit.status.message;
   if (!run.fit.status.ok()) return run;

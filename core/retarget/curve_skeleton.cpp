@@ -412,7 +412,10 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
     // A side branch is pruned when shorter than prune_length or than the local radius (bumps,
     // and the fragments a band's ring breaks into where a limb's cap is cut obliquely); the
     // limb's own tip likewise when shorter than the radius (the node then ends the limb).
-    const double r_here = (rmax[c] + 0.5) * h;
+    // The local radius: depth of the solid at the node's centroid (a band component near the
+    // surface, where a blocky part's corners split off, has a small own depth but sits in a thick part).
+    const double r_here = std::max<double>(rmax[c] + 0.5, vs.depth[vs.grid.index(vs.grid.coord(pos[c][0], 0), vs.grid.coord(pos[c][1], 1),
+                                                                          vs.grid.coord(pos[c][2], 2))]) * h;
     double kept = 0;
     for (int k : kids[c]) {
       const double len = reach[k] + (pos[k] - pos[c]).norm();

@@ -43,7 +43,7 @@ struct CurveSkeletonOptions {
   int resolution = 96;          // grid cells along the longest bounding-box side, in [16, 512]
   double band_width = 2.0;      // geodesic band width in cells, ≥ √3 (see 4. above)
   int close_holes = 1;          // dilation/erosion radius in cells that closes holes in the surface (0 = none)
-  double prune_length = 0.05;   // side branches shorter than this × the longest side are removed
+  double prune_length = 0.08;   // side branches shorter than this × the longest side are removed
   double prune_radius = 1.0;    // ... and leaf branches shorter than this × the radius where they start
   int smoothing_iterations = 3; // Laplacian smoothing passes over chain (degree-2) nodes
 };

@@ -1,6 +1,7 @@
 #include "retarget/joint_fitting.h"
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -197,7 +198,9 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
     r.status = Status::error(c, m);
     return r;
   };
-  if (opt.source_up < 0 || opt.source_up > 5 || opt.target_up < -1 || opt.target_up > 5)
+  if (opt.source_up < 0 || opt.source_up > 5 || opt.target_up < -1 || opt.target_up > 5 || opt.source_front < 0 ||
+      opt.source_front > 5 || opt.target_front < -1 || opt.target_front > 5 || opt.source_up % 3 == opt.source_front % 3 ||
+      (opt.target_up >= 0 && opt.target_front >= 0 && opt.target_up % 3 == opt.target_front % 3))
     return fail(StatusCode::InvalidArgument, "up axes must be -1 (target: detect) or 0..5 (+x, +y, +z, -x, -y, -z)");
   if (source_joints.size() < 2) return fail(StatusCode::InvalidArgument, "the source has fewer than 2 joints");
   r.source_skeleton = curve_skeleton(Vs, Fs, opt.skeleton, progress.sub(0, 0.45));
@@ -259,6 +262,7 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
   JfFrame ft;
   for (const Eigen::Matrix3d& R : jf_rotations()) {
     if ((R * ut - us).norm() > 1e-9) continue;
+    if (opt.target_front >= 0 && (R * jf_axis(opt.target_front) - jf_axis(opt.source_front)).norm() > 1e-9) continue;
     const Eigen::MatrixXd Vr = Vt * R.transpose();
     const JfFrame f = jf_frame(Vr, us);
     Eigen::MatrixXd Pt_n(Pt.rows(), 3);
@@ -271,8 +275,26 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
   }
   const Eigen::Matrix3d R = r.rotation;
   r.limb_ends = match.pairs;
-  for (int i = 0; i < Ls.rows(); ++i) r.source_ground += fs.height(Ls.row(i).transpose()) < opt.ground_band;
-  for (int i = 0; i < Lt.rows(); ++i) r.target_ground += ft.height(R * Lt.row(i).transpose()) < opt.ground_band;
+  // Limbs on the ground: ground limb ends grouped when their paths meet low (the corners of one
+  // blocky boot meet inside the foot; two feet meet at the crotch or the body).
+  auto ground_limbs = [&](const JfTree& tree, const std::vector<int>& leaves, const std::function<double(int)>& height) {
+    std::vector<int> g;
+    for (int l : leaves)
+      if (height(l) < opt.ground_band) g.push_back(l);
+    std::vector<int> group(g.size());
+    for (size_t i = 0; i < g.size(); ++i) group[i] = int(i);
+    for (size_t i = 0; i < g.size(); ++i)
+      for (size_t j = i + 1; j < g.size(); ++j)
+        if (height(tree.lca(g[i], g[j])) < 2.5 * opt.ground_band) {
+          const int a = group[i], b = group[j];
+          for (int& x : group)
+            if (x == b) x = a;
+        }
+    std::sort(group.begin(), group.end());
+    return int(std::unique(group.begin(), group.end()) - group.begin());
+  };
+  r.source_ground = ground_limbs(st, s_leaves, [&](int n) { return fs.height(st.pos(n)); });
+  r.target_ground = ground_limbs(tt, t_leaves, [&](int n) { return ft.height(R * tt.pos(n)); });
 
   // Closest points of the used source joints on the whole source skeleton, to find which limb
   // ends carry joints (an edge (u, parent u) whose subtree below holds a single leaf is that leaf's).

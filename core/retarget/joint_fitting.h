@@ -6,7 +6,7 @@
 //  1. curve skeletons of both rest shapes (same options, so both sides are cut alike);
 //  2. up direction: the source's is given (glTF +Y); the target's is the signed axis with the
 //     most limb ends (skeleton leaves) near its low end — feet stand on the ground — unless given;
-//  3. facing: the 4 axis-aligned turns about up are scored by the chamfer distance between the two
+//  3. facing (unless given, e.g. +z for glTF by its spec): the 4 axis-aligned turns about up are scored by the chamfer distance between the two
 //     solids (normalised: feet at 0, height 1, centred) plus the distance of matched limb ends;
 //  4. limb ends are matched greedily by normalised position (≤ leaf_tolerance × height apart);
 //     a source limb end that carries joints with no match is a topology mismatch, and so is a
@@ -43,6 +43,8 @@ struct JointFitOptions {
   CurveSkeletonOptions skeleton;  // both shapes' skeletons
   int source_up = 1;              // source up axis: 0..2 = +x,+y,+z, 3..5 = −x,−y,−z (glTF: 1)
   int target_up = -1;             // target up axis as source_up; −1 = detect from the limb ends
+  int source_front = 2;           // source facing axis, as source_up (glTF: +z)
+  int target_front = -1;          // target facing axis; −1 = detect (step 3)
   double leaf_tolerance = 0.3;    // limb ends match when ≤ this × height apart (normalised shapes)
   double ground_band = 0.12;      // limb ends below this × height count as standing on the ground
   double inside_tolerance = 0.01; // a joint within this × bbox diagonal outside the surface counts as inside
