@@ -210,6 +210,7 @@ JfRun jf_fit_characters(const std::string& source, const std::string& target,
   run.fit = mm::fit_joints(s.c.V_rest, s.c.F, s.joints, t.c.V_rest, t.c.F, {}, o);
   run.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_TRUE(run.fit.status.ok()) << run.fit.status.message;
+  if (std::getenv("MM_JF_DEBUG")) jf_print(target, {}, run.fit);
   if (!run.fit.status.ok()) return run;
   run.error = jf_joint_error(run.fit.joints, t.joints, jf_extent(t.c.V_rest, 1), map);
   run.outside = jf_outside(run.fit.joints, t.c.V_rest, t.c.F);
@@ -301,6 +302,7 @@ TEST(JointFitting, StaticMeshesAgainstHandPlacedJoints) {
     const auto t0 = std::chrono::steady_clock::now();
     const mm::JointFitResult fit = mm::fit_joints(s.c.V_rest, s.c.F, s.joints, t.asset.V_raw, t.asset.F_raw);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (std::getenv("MM_JF_DEBUG")) jf_print(c.target, {}, fit);
     ASSERT_TRUE(fit.status.ok()) << c.target << ": " << fit.status.message;
     const double H = jf_extent(t.asset.V_raw, fit.target_up % 3);
     const JfError e = jf_joint_error(fit.joints, truth.joints, H);
@@ -320,11 +322,19 @@ TEST(JointFitting, BipedOnQuadrupedIsRefused) {
   EXPECT_EQ(r.status.code, mm::StatusCode::InvalidArgument);
   EXPECT_NE(r.status.message.find("topology mismatch"), std::string::npos) << r.status.message;
   std::cout << "[ Knight on wolf0 ] " << r.status.message << "\n";
-  r = mm::fit_joints(knight.c.V_rest, knight.c.F, knight.joints, fox.c.V_rest, fox.c.F);
+  r = mm::fit_joints(knight.c.V_rest, knight.c.F, knight.joints, fox.c.V_rest, fox.c.F, {}, [] {
+    mm::JointFitOptions o;
+    o.target_up = 1;
+    o.target_front = 2;
+    return o;
+  }());
   EXPECT_EQ(r.status.code, mm::StatusCode::InvalidArgument);
   EXPECT_NE(r.status.message.find("topology mismatch"), std::string::npos) << r.status.message;
-  // And a quadruped skeleton on a biped.
-  r = mm::fit_joints(fox.c.V_rest, fox.c.F, fox.joints, knight.c.V_rest, knight.c.F);
+  // And a quadruped skeleton on a biped (glTF: +Y up, +Z front).
+  mm::JointFitOptions gltf;
+  gltf.target_up = 1;
+  gltf.target_front = 2;
+  r = mm::fit_joints(fox.c.V_rest, fox.c.F, fox.joints, knight.c.V_rest, knight.c.F, {}, gltf);
   EXPECT_EQ(r.status.code, mm::StatusCode::InvalidArgument);
   EXPECT_NE(r.status.message.find("topology mismatch"), std::string::npos) << r.status.message;
   std::cout << "[ Fox on Knight ] " << r.status.message << "\n";

@@ -164,10 +164,12 @@ JfLeafMatch jf_match_leaves(const std::vector<Eigen::Vector3d>& S, const std::ve
     int i, j;
   };
   std::vector<Cand> c;
-  for (size_t i = 0; i < S.size(); ++i)
-    for (size_t j = 0; j < T.size(); ++j) c.push_back({(S[i] - T[j]).norm(), int(i), int(j)});
+  // S, T: two points per limb end (end, back point); the cost is their mean distance.
+  for (size_t i = 0; i < S.size() / 2; ++i)
+    for (size_t j = 0; j < T.size() / 2; ++j)
+      c.push_back({0.5 * ((S[2 * i] - T[2 * j]).norm() + (S[2 * i + 1] - T[2 * j + 1]).norm()), int(i), int(j)});
   std::stable_sort(c.begin(), c.end(), [](const Cand& a, const Cand& b) { return a.d < b.d; });
-  std::vector<uint8_t> us(S.size(), 0), ut(T.size(), 0);
+  std::vector<uint8_t> us(S.size() / 2, 0), ut(T.size() / 2, 0);
   JfLeafMatch m;
   for (const Cand& x : c) {
     if (x.d > tol || us[x.i] || ut[x.j]) continue;
@@ -175,7 +177,7 @@ JfLeafMatch jf_match_leaves(const std::vector<Eigen::Vector3d>& S, const std::ve
     m.pairs.push_back({s_nodes[x.i], t_nodes[x.j]});
     m.cost += x.d;
   }
-  for (size_t i = 0; i < S.size(); ++i)
+  for (size_t i = 0; i < us.size(); ++i)
     if (!us[i]) m.cost += tol;
   return m;
 }
@@ -255,8 +257,22 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
   const Eigen::MatrixXd Ps = jf_solid_samples(SS.volume, 1200), Pt = jf_solid_samples(TS.volume, 1200);
   Eigen::MatrixXd Ps_n(Ps.rows(), 3);
   for (int i = 0; i < Ps.rows(); ++i) Ps_n.row(i) = fs(Ps.row(i).transpose()).transpose();
+  // Limb-end descriptors: the end and the point back_length × height up its path toward the
+  // root (elbow/knee-ish), so that an A-pose and a T-pose still pair hands with hands.
+  auto back_point = [&](const JfTree& tree, int leaf, double length) {
+    int a = leaf;
+    double arc = 0;
+    while (tree.s->parent[a] >= 0 && arc < length) {
+      arc += (tree.pos(tree.s->parent[a]) - tree.pos(a)).norm();
+      a = tree.s->parent[a];
+    }
+    return tree.pos(a);
+  };
   std::vector<Eigen::Vector3d> Sn;
-  for (int i = 0; i < Ls.rows(); ++i) Sn.push_back(fs(Ls.row(i).transpose()));
+  for (int i = 0; i < Ls.rows(); ++i) {
+    Sn.push_back(fs(Ls.row(i).transpose()));
+    Sn.push_back(fs(back_point(st, s_leaves[i], opt.back_length * fs.H)));
+  }
   double best_cost = std::numeric_limits<double>::infinity();
   JfLeafMatch match;
   JfFrame ft;
@@ -268,9 +284,12 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
     Eigen::MatrixXd Pt_n(Pt.rows(), 3);
     for (int i = 0; i < Pt.rows(); ++i) Pt_n.row(i) = f(R * Pt.row(i).transpose()).transpose();
     std::vector<Eigen::Vector3d> Tn;
-    for (int i = 0; i < Lt.rows(); ++i) Tn.push_back(f(R * Lt.row(i).transpose()));
+    for (int i = 0; i < Lt.rows(); ++i) {
+      Tn.push_back(f(R * Lt.row(i).transpose()));
+      Tn.push_back(f(R * back_point(tt, t_leaves[i], opt.back_length * f.H)));
+    }
     JfLeafMatch m = jf_match_leaves(Sn, s_leaves, Tn, t_leaves, opt.leaf_tolerance);
-    const double cost = jf_chamfer(Ps_n, Pt_n) + m.cost / std::max<size_t>(1, Sn.size());
+    const double cost = jf_chamfer(Ps_n, Pt_n) + m.cost / std::max<size_t>(1, s_leaves.size());
     if (cost < best_cost) best_cost = cost, match = m, r.rotation = R, ft = f;
   }
   const Eigen::Matrix3d R = r.rotation;
@@ -285,7 +304,7 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
     for (size_t i = 0; i < g.size(); ++i) group[i] = int(i);
     for (size_t i = 0; i < g.size(); ++i)
       for (size_t j = i + 1; j < g.size(); ++j)
-        if (height(tree.lca(g[i], g[j])) < 2.5 * opt.ground_band) {
+        if (height(tree.lca(g[i], g[j])) < opt.ground_band) {
           const int a = group[i], b = group[j];
           for (int& x : group)
             if (x == b) x = a;
@@ -341,8 +360,18 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
   for (size_t k = 0; k < match.pairs.size(); ++k) matched_s[match.pairs[k].first] = int(k);
   if (opt.check_topology) {
     std::vector<std::string> lost;
-    for (const auto& [leaf, names] : joints_on_leaf)
-      if (!matched_s.count(leaf) && names.size() >= 2) lost.push_back(names.back());
+    // An unmatched end carrying joints is lost unless it is a sub-branch of a matched limb
+    // (another finger of a matched hand): path length to a matched end < back_length × height.
+    for (const auto& [leaf, names] : joints_on_leaf) {
+      if (matched_s.count(leaf) || names.size() < 2) continue;
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const auto& pr : match.pairs) {
+        const int l = st.lca(leaf, pr.first);
+        const double d = (st.pos(leaf) - st.pos(l)).norm() + (st.pos(pr.first) - st.pos(l)).norm();
+        nearest = std::min(nearest, d);
+      }
+      if (nearest > opt.back_length * fs.H) lost.push_back(names.back());
+    }
     const std::string counts = "the source has " + std::to_string(s_leaves.size()) + " limb ends (" +
                                std::to_string(r.source_ground) + " on the ground), the target " +
                                std::to_string(t_leaves.size()) + " (" + std::to_string(r.target_ground) +
@@ -454,6 +483,21 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
     Eigen::Vector3d p = qt + off;
     for (int it = 0; it < 6 && !inside_t(p); ++it) p = qt + off * std::pow(0.5, it + 1);
     if (!inside_t(p)) p = qt;
+    if (!inside_t(p)) {
+      // Between parts (a robot's gap at a knee): just inside the nearest surface.
+      const ClosestPoint c = bvh_t.closest_point(p);
+      if (c.face >= 0) {
+        const Eigen::Vector3d a = Vt.row(Ft(c.face, 0)), b = Vt.row(Ft(c.face, 1)), d = Vt.row(Ft(c.face, 2));
+        const Eigen::Vector3d n = (b - a).cross(d - a).normalized();
+        for (double side : {1.0, -1.0}) {
+          const Eigen::Vector3d x = c.point - side * 0.5 * tol_t * n;
+          if (n.allFinite() && bvh_t.inside(x)) {
+            p = x;
+            break;
+          }
+        }
+      }
+    }
     if (!inside_t(p)) outside.push_back(source_joints.names[j]);
     out_index[j] = out.size();
     out.names.push_back(source_joints.names[j]);

@@ -8,7 +8,8 @@
 //     most limb ends (skeleton leaves) near its low end — feet stand on the ground — unless given;
 //  3. facing (unless given, e.g. +z for glTF by its spec): the 4 axis-aligned turns about up are scored by the chamfer distance between the two
 //     solids (normalised: feet at 0, height 1, centred) plus the distance of matched limb ends;
-//  4. limb ends are matched greedily by normalised position (≤ leaf_tolerance × height apart);
+//  4. limb ends are matched greedily by normalised position of the end and of a point back_length
+//     up its path (≤ leaf_tolerance × height apart), so A- and T-poses pair hands with hands;
 //     a source limb end that carries joints with no match is a topology mismatch, and so is a
 //     different number of limbs on the ground (biped vs quadruped);
 //  5. each source joint is located on the source skeleton (closest point q on the paths between
@@ -45,7 +46,9 @@ struct JointFitOptions {
   int target_up = -1;             // target up axis as source_up; −1 = detect from the limb ends
   int source_front = 2;           // source facing axis, as source_up (glTF: +z)
   int target_front = -1;          // target facing axis; −1 = detect (step 3)
-  double leaf_tolerance = 0.3;    // limb ends match when ≤ this × height apart (normalised shapes)
+  double leaf_tolerance = 0.4;    // limb ends match when ≤ this × height apart (normalised shapes; mean of
+                                  // the ends' and the back points' distances)
+  double back_length = 0.25;      // back point of a limb end: this × height up its path (pose-robust matching)
   double ground_band = 0.12;      // limb ends below this × height count as standing on the ground
   double inside_tolerance = 0.01; // a joint within this × bbox diagonal outside the surface counts as inside
   int marker_reach = 3;           // markers move unpinned joints up to this many bones away (0 = only pin)
