@@ -46,7 +46,7 @@ struct JointFitOptions {
   int target_up = -1;             // target up axis as source_up; −1 = detect from the limb ends
   int source_front = 2;           // source facing axis, as source_up (glTF: +z)
   int target_front = -1;          // target facing axis; −1 = detect (step 3)
-  double leaf_tolerance = 0.4;    // limb ends match when ≤ this × height apart (normalised shapes; mean of
+  double leaf_tolerance = 0.6;    // limb ends match when ≤ this × height apart (normalised shapes; mean of
                                   // the ends' and the back points' distances)
   double back_length = 0.25;      // back point of a limb end: this × height up its path (pose-robust matching)
   double ground_band = 0.12;      // limb ends below this × height count as standing on the ground
