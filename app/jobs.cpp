@@ -1,6 +1,7 @@
 #include "app/jobs.h"
 
 #include "app/edit_job.h"
+#include "app/joints_job.h"
 #include "app/merge_job.h"
 #include "app/retarget_job.h"
 #include "app/transfer_job.h"
@@ -13,6 +14,7 @@ const std::vector<JobSchema>& job_schemas() {
       {"merge", merge_options().json(), merge_options().help()},
       {"transfer", transfer_options().json(), transfer_options().help()},
       {"retarget", retarget_options().json(), retarget_options().help()},
+      {"joints", joints_options().json(), joints_options().help()},
   };
   return jobs;
 }

@@ -6,6 +6,7 @@ list(APPEND MM_CORE_SOURCES
   app/edit_spec.cpp
   app/edit_job.cpp
   app/retarget_job.cpp
+  app/joints_job.cpp
   app/merge_job.cpp
   app/jobs.cpp
   app/batch_manifest.cpp

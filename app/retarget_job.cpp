@@ -5,6 +5,7 @@
 #include "character/prop_tracks.h"
 #include "io/gltf_document.h"
 #include "io/joints_json.h"
+#include "retarget/joint_fitting.h"
 
 namespace mm::app {
 
@@ -89,7 +90,15 @@ Status RetargetJob::prepare(const io::Asset& source, const io::Asset& target, co
     target_V_ = target.V_raw;
     target_F_ = target.F_raw;
   }
-  if (!target_joints_json.empty()) {
+  if (target_joints_json == "auto") {
+    // Automatic joints (issue 14): the source's skeleton fitted inside the target.
+    JointFitOptions fo;
+    if (target_is_gltf_) fo.target_up = 1, fo.target_front = 2;  // glTF: +Y up, front +Z by its spec
+    JointFitResult fit = fit_joints(source_.V_rest, source_.F, character_joints(source_), target_V_, target_F_, {}, fo,
+                                    progress.sub(0, 0.3));
+    if (!fit.status.ok()) return Status{fit.status.code, "automatic target joints: " + fit.status.message};
+    target_joints = std::move(fit.joints);
+  } else if (!target_joints_json.empty()) {
     io::JointSetResult jr = io::parse_joints_json(target_joints_json);
     if (!jr.status.ok()) return Status{jr.status.code, "target joints: " + jr.status.message};
     target_joints = std::move(jr.joints);
@@ -108,7 +117,7 @@ Status RetargetJob::prepare(const io::Asset& source, const io::Asset& target, co
   RetargetCharacter S{source_.V_rest, source_.F, source_joints};
   RetargetCharacter T{target_V_, target_F_, target_joints};
   if (opt.method == RetargetMethod::Harmonic) {
-    s = harmonic_.precompute(S, T, map, opt.harmonic, progress);
+    s = harmonic_.precompute(S, T, map, opt.harmonic, target_joints_json == "auto" ? progress.sub(0.3, 1) : progress);
     if (!s.ok()) return s;
     for (auto& w : harmonic_.warnings()) warnings_.push_back(w);
     return Status::success();

@@ -43,7 +43,8 @@ const OptionSchema<RetargetJobOptions>& retarget_options();
 class RetargetJob {
  public:
   // source: a skinned, animated glTF. target: glTF or mesh. target_joints_json: {"name": [x,y,z]}
-  // (required when the target has no skin; overrides its skin otherwise). joint_map_json:
+  // (required when the target has no skin; overrides its skin otherwise), or "auto": the source's
+  // joints fitted inside the target (retarget/joint_fitting.h, default options). joint_map_json:
   // {"source joint": "target joint"} or "". Progress stages of the harmonic precompute.
   Status prepare(const io::Asset& source, const io::Asset& target, const std::string& target_joints_json,
                  const std::string& joint_map_json, const RetargetJobOptions& opt, const Progress& progress = {});

@@ -2,7 +2,7 @@
 // options panels (the same schema gives the CLI its flags and --help, see app/option_schema.h).
 //
 // JS API:
-//   optionSchema(job: "edit" | "merge" | "transfer" | "retarget")  (app/jobs.h)
+//   optionSchema(job: "edit" | "merge" | "transfer" | "retarget" | "joints")  (app/jobs.h)
 //     → {ok, schema: {job, summary, options: [{name, kind, default, min?, max?, choices?, flag, help}]}}
 #include <string>
 

@@ -13,6 +13,13 @@
 //   retargetExportGlb(session, positions: Float32Array|Float64Array (all frames, frame-major))
 //                   → {ok, bytes: Uint8Array}
 //   retargetDispose(session) → boolean
+//   retargetJoints(sourceBytes, sourceName, targetBytes, targetName, markersJson: string ("" = none),
+//                  options?, progress?) → {ok, json: string ({"name": [x,y,z]}, for retargetPrepare's
+//                  targetJointsJson), names: string[], positions: Float32Array (#J·3, target
+//                  coordinates), parents: number[] (-1 roots), skipped: string[], warnings: string[],
+//                  skeletonPositions: Float32Array (#N·3 target curve skeleton), skeletonParents:
+//                  number[], targetUp: number, limbEnds: number (matched)}
+//     options: any option of the joints job's schema (app/joints_job.h; optionSchema("joints"))
 #include <map>
 #include <memory>
 #include <string>
@@ -22,6 +29,7 @@
 
 #include "convert.h"
 #include "io/asset.h"
+#include "app/joints_job.h"
 #include "app/retarget_job.h"
 #include "guard.h"
 
@@ -113,6 +121,40 @@ emscripten::val retarget_export_glb(int id, emscripten::val positions) {
 
 bool retarget_dispose(int id) { return retarget_sessions().erase(id) > 0; }
 
+emscripten::val retarget_joints(emscripten::val src, std::string src_name, emscripten::val tgt, std::string tgt_name,
+                                std::string markers, emscripten::val options, emscripten::val progress) {
+  const io::LoadResult s = load_bytes(src, src_name);
+  if (!s.status.ok()) return status_object(s.status);
+  const io::LoadResult t = load_bytes(tgt, tgt_name);
+  if (!t.status.ok()) return status_object(t.status);
+  app::JointsJobOptions o;
+  if (Status os = read_options(options, app::joints_options(), &o); !os.ok()) return status_object(os);
+  const app::JointsJobResult r = app::run_joints_job(s.asset, t.asset, markers, o, js_progress(progress));
+  if (!r.status.ok()) return status_object(r.status);
+  emscripten::val out = status_object(r.status);
+  auto strings = [](const std::vector<std::string>& v) {
+    emscripten::val a = emscripten::val::array();
+    for (const auto& x : v) a.call<void>("push", x);
+    return a;
+  };
+  auto ints = [](const std::vector<int>& v) {
+    emscripten::val a = emscripten::val::array();
+    for (int x : v) a.call<void>("push", x);
+    return a;
+  };
+  out.set("json", r.json);
+  out.set("names", strings(r.fit.joints.names));
+  out.set("positions", to_float32_array(r.fit.joints.P));
+  out.set("parents", ints(r.fit.joints.parent));
+  out.set("skipped", strings(r.fit.skipped));
+  out.set("warnings", strings(r.warnings));
+  out.set("skeletonPositions", to_float32_array(r.fit.target_skeleton.nodes));
+  out.set("skeletonParents", ints(r.fit.target_skeleton.parent));
+  out.set("targetUp", r.fit.target_up);
+  out.set("limbEnds", static_cast<int>(r.fit.limb_ends.size()));
+  return out;
+}
+
 }  // namespace
 }  // namespace mm::wasm
 
@@ -122,4 +164,5 @@ EMSCRIPTEN_BINDINGS(meshmorph_retarget) {
   bind<&retarget_frames>("retargetFrames");
   bind<&retarget_export_glb>("retargetExportGlb");
   bind<&retarget_dispose>("retargetDispose");
+  bind<&retarget_joints>("retargetJoints");
 }

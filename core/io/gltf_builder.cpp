@@ -52,9 +52,10 @@ int gltf_append_float_accessor(tinygltf::Model* model, int buffer, const Eigen::
 }
 
 int gltf_append_index_accessor(tinygltf::Model* model, int buffer, const Eigen::MatrixXi& F) {
-  std::vector<uint32_t> idx(static_cast<size_t>(F.rows()) * 3);
+  const Eigen::Index w = F.cols();
+  std::vector<uint32_t> idx(static_cast<size_t>(F.rows()) * w);
   for (Eigen::Index f = 0; f < F.rows(); ++f)
-    for (int c = 0; c < 3; ++c) idx[f * 3 + c] = static_cast<uint32_t>(F(f, c));
+    for (Eigen::Index c = 0; c < w; ++c) idx[f * w + c] = static_cast<uint32_t>(F(f, c));
   tinygltf::Accessor a;
   a.bufferView = gltf_append_view(model, buffer, reinterpret_cast<const uint8_t*>(idx.data()),
                                   idx.size() * sizeof(uint32_t), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);

@@ -19,7 +19,8 @@ int gltf_append_view(tinygltf::Model* model, int buffer, const uint8_t* data, si
 // (ARRAY_BUFFER) of `buffer`; with_min_max writes min/max of the float values. Returns its index.
 int gltf_append_float_accessor(tinygltf::Model* model, int buffer, const Eigen::MatrixXd& M, bool with_min_max);
 
-// Appends an UNSIGNED_INT SCALAR index accessor (ELEMENT_ARRAY_BUFFER) for triangles F.
+// Appends an UNSIGNED_INT SCALAR index accessor (ELEMENT_ARRAY_BUFFER) for the rows of F, row by
+// row (triangles: 3 columns; line segments: 2).
 int gltf_append_index_accessor(tinygltf::Model* model, int buffer, const Eigen::MatrixXi& F);
 
 }  // namespace mm::io

@@ -4,5 +4,7 @@ list(APPEND MM_CORE_SOURCES
   core/retarget/bone_correspondence.cpp
   core/retarget/harmonic_synthesis.cpp
   core/retarget/harmonic_retarget.cpp
-  core/retarget/lbs_baseline.cpp)
-list(APPEND MM_TEST_SOURCES tests/retarget_test.cpp)
+  core/retarget/lbs_baseline.cpp
+  core/retarget/curve_skeleton.cpp
+  core/retarget/joint_fitting.cpp)
+list(APPEND MM_TEST_SOURCES tests/retarget_test.cpp tests/joint_fitting_test.cpp)

@@ -1,4 +1,5 @@
 // meshmorph retarget: animate a target character with a source character's clip (paper 002).
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -7,7 +8,9 @@
 
 #include "cli.h"
 #include "io/asset.h"
+#include "app/joints_job.h"
 #include "app/retarget_job.h"
+#include "io/debug_lines_glb.h"
 #include "metrics/retarget_metrics.h"
 
 namespace {
@@ -21,7 +24,8 @@ morph target per frame and an animation of their weights (plays in three.js and 
 OUT with .obj/.ply/.off writes one mesh file per frame (OUT_0000.obj, ...).
 
   --target-joints J.json   {"joint name": [x, y, z], ...} with the source's joint names
-                           (needed when TGT has no skin)
+                           (needed when TGT has no skin); "auto" fits the source's joints
+                           inside TGT (as `meshmorph joints`, default options)
   --joint-map M.json       {"source joint": "target joint", ...} where names differ
   --frames a:b             shorthand for --first-frame a --last-frame b (either side optional)
 options (app/retarget_job.h):
@@ -62,7 +66,8 @@ int run_retarget(const std::vector<std::string>& argv) {
     if (!fs.ok()) return cli::report("retarget", Status::error(fs.code, "--frames: " + fs.message));
   }
   std::string joints_json, map_json;
-  if (args.has("target-joints") && !(s = read_text(args.get("target-joints"), &joints_json)).ok())
+  if (args.has("target-joints") && args.get("target-joints") == "auto") joints_json = "auto";
+  else if (args.has("target-joints") && !(s = read_text(args.get("target-joints"), &joints_json)).ok())
     return cli::report("retarget", s);
   if (args.has("joint-map") && !(s = read_text(args.get("joint-map"), &map_json)).ok()) return cli::report("retarget", s);
   if (!(s = cli::check_unused(args)).ok()) return cli::report("retarget", s);
@@ -116,5 +121,103 @@ int run_retarget(const std::vector<std::string>& argv) {
 }
 
 }  // namespace
+
+namespace {
+
+const char* kJointsUsage = R"(usage: meshmorph joints TARGET --like SOURCE.glb --out J.json [--markers M.json]
+                       [--debug-skeleton OUT.glb] [options]
+
+Places the joints of the skinned SOURCE inside the unrigged TARGET (glTF or OBJ/OFF/PLY):
+curve skeletons of both (voxel level-set skeleton), limbs matched after aligning up and
+facing, joints carried over by their proportions along each limb (retarget/joint_fitting.h).
+J.json is {"joint name": [x, y, z]} in TARGET's coordinates, ready for
+`meshmorph retarget --target-joints J.json`.
+
+  --markers M.json         {"joint name": [x, y, z]}: pin these source joints (chin, wrists,
+                           knees, ...) where the automatic fit is wrong
+  --debug-skeleton OUT.glb both skeletons (lines), the fitted joints and bones, and the target
+                           surface (translucent), for viewing
+options (app/joints_job.h):
+)";
+
+int run_joints(const std::vector<std::string>& argv) {
+  using namespace mm;
+  cli::Args args;
+  Status s = args.parse(argv, {"help"});
+  if (!s.ok()) return cli::report("joints", s);
+  if (args.has("help")) {
+    std::cout << kJointsUsage << app::joints_options().help();
+    return 0;
+  }
+  const std::string src_path = args.get("like"), out_path = args.get("out"), debug_path = args.get("debug-skeleton");
+  if (args.positional().size() != 1 || src_path.empty() || out_path.empty())
+    return cli::report("joints", Status::error(StatusCode::InvalidArgument, "expected TARGET --like SOURCE.glb --out J.json (see --help)"));
+  const std::string tgt_path = args.positional()[0];
+  app::JointsJobOptions opt;
+  if (!(s = cli::read_options(args, app::joints_options(), &opt)).ok()) return cli::report("joints", s);
+  std::string markers_json;
+  if (args.has("markers") && !(s = read_text(args.get("markers"), &markers_json)).ok()) return cli::report("joints", s);
+  if (!(s = cli::check_unused(args)).ok()) return cli::report("joints", s);
+  if (!(s = io::check_output_path(out_path)).ok()) return cli::report("joints", s);
+  if (!debug_path.empty() && !(s = io::check_output_path(debug_path)).ok()) return cli::report("joints", s);
+  io::LoadResult src = io::load_asset(src_path);
+  if (!src.status.ok()) return cli::report("joints", src.status);
+  io::LoadResult tgt = io::load_asset(tgt_path);
+  if (!tgt.status.ok()) return cli::report("joints", tgt.status);
+  const auto t0 = std::chrono::steady_clock::now();
+  const app::JointsJobResult r = app::run_joints_job(src.asset, tgt.asset, markers_json, opt, cli::terminal_progress());
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  for (const auto& w : r.warnings) std::cerr << "meshmorph joints: warning: " << w << "\n";
+  if (!r.status.ok()) return cli::report("joints", r.status);
+  const std::vector<uint8_t> bytes(r.json.begin(), r.json.end());
+  if (!(s = io::write_file_atomic(out_path, bytes)).ok()) return cli::report("joints", s);
+  if (!debug_path.empty()) {
+    auto skeleton_set = [](const CurveSkeleton& sk, const Eigen::Matrix3d& to_target, const std::string& name,
+                           std::array<float, 4> color) {
+      io::DebugGeometry g;
+      g.name = name;
+      g.P = sk.nodes * to_target.transpose();
+      for (int i = 0; i < sk.size(); ++i)
+        if (sk.parent[i] >= 0) g.lines.push_back({i, sk.parent[i]});
+      g.color = color;
+      return g;
+    };
+    std::vector<io::DebugGeometry> sets;
+    io::DebugGeometry surface;
+    surface.name = "target surface";
+    surface.P = r.target_V;
+    surface.F = r.target_F;
+    surface.color = {0.7f, 0.7f, 0.75f, 0.25f};
+    sets.push_back(surface);
+    sets.push_back(skeleton_set(r.fit.target_skeleton, Eigen::Matrix3d::Identity(), "target curve skeleton", {0.1f, 0.6f, 1, 1}));
+    io::DebugGeometry joints, bones;
+    joints.name = "fitted joints";
+    joints.P = r.fit.joints.P;
+    joints.color = {1, 0.2f, 0.1f, 1};
+    bones.name = "fitted bones";
+    bones.P = r.fit.joints.P;
+    for (int j = 0; j < r.fit.joints.size(); ++j)
+      if (r.fit.joints.parent[j] >= 0) bones.lines.push_back({j, r.fit.joints.parent[j]});
+    bones.color = {1, 0.6f, 0.1f, 1};
+    sets.push_back(joints);
+    if (!bones.lines.empty()) sets.push_back(bones);
+    std::vector<uint8_t> glb;
+    if (!(s = io::debug_geometry_glb(sets, &glb)).ok()) return cli::report("joints", s);
+    if (!(s = io::write_file_atomic(debug_path, glb)).ok()) return cli::report("joints", s);
+  }
+  const auto& fit = r.fit;
+  std::cout << "joints: " << fit.joints.size() << " joints placed (" << fit.skipped.size()
+            << " source joints outside the source surface skipped) in " << static_cast<int>(ms) << " ms; skeletons "
+            << fit.source_skeleton.size() << " / " << fit.target_skeleton.size() << " nodes, limb ends "
+            << fit.source_skeleton.leaves().size() << " / " << fit.target_skeleton.leaves().size() << " ("
+            << fit.limb_ends.size() << " matched), target up axis " << fit.target_up << "\n  wrote " << out_path << "\n";
+  if (!debug_path.empty()) std::cout << "  wrote " << debug_path << "\n";
+  return 0;
+}
+
+}  // namespace
+
+MM_COMMAND(joints, "automatic joints: fit a source character's skeleton inside an unrigged target", run_joints);
+
 
 MM_COMMAND(retarget, "animate a target mesh with a source character's clip (harmonic maps, paper 002)", run_retarget);

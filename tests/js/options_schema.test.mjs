@@ -10,7 +10,7 @@ import { test } from 'node:test';
 import { loadModule, repoDir } from './wasm_module.mjs';
 
 const cli = process.env.MM_CLI || path.join(repoDir, 'build/native/native/meshmorph');
-const jobs = ['edit', 'merge', 'transfer', 'retarget'];
+const jobs = ['edit', 'merge', 'transfer', 'retarget', 'joints'];
 
 function nativeSchemas() {
   return JSON.parse(execFileSync(cli, ['options', '--json'], { encoding: 'utf8' })).jobs;

@@ -62,7 +62,7 @@ export interface OptionDescription {
   flag: string;                 // the CLI flag, e.g. "--cage-vertices"
   help: string;                 // one line
 }
-export interface OptionSchema { job: 'edit' | 'transfer' | 'retarget'; summary: string; options: OptionDescription[] }
+export interface OptionSchema { job: 'edit' | 'transfer' | 'retarget' | 'joints' | 'merge'; summary: string; options: OptionDescription[] }
 
 export interface MeshMorphModule {
   /** The options schema of a job (`meshmorph options --json` prints the same). */
@@ -101,6 +101,25 @@ export interface MeshMorphModule {
     eigenvalues: Float64Array;  // k, ascending
     vectors: Float32Array;      // k·#V, function i at [i·#V, (i+1)·#V)
     iterations: number; operations: number;
+  }>;
+  /** Automatic joints (wasm/bind_retarget.cpp, app/joints_job.h): the skinned source's joints
+   *  fitted inside the target (glTF or mesh file). markersJson: {"joint": [x, y, z]} pins, or "".
+   *  Errors: InvalidMesh (no skeleton: empty, flat or broken target), InvalidArgument (topology
+   *  mismatch such as a biped skeleton on a quadruped, unknown marker or marker outside, a joint
+   *  that cannot be placed inside: pin it with a marker), Cancelled. */
+  retargetJoints(sourceBytes: Uint8Array, sourceName: string, targetBytes: Uint8Array, targetName: string,
+                 markersJson: string, options: object | undefined,
+                 progress: ((stage: string, fraction: number) => boolean) | undefined): Result<{
+    json: string;                 // {"name": [x, y, z]}: retargetPrepare's targetJointsJson
+    names: string[];              // #J source joint names (joints inside the source surface)
+    positions: Float32Array;      // #J·3, target coordinates
+    parents: number[];            // #J, -1 for roots
+    skipped: string[];            // source joints outside the source surface (not placed)
+    warnings: string[];
+    skeletonPositions: Float32Array;  // #N·3 target curve skeleton nodes
+    skeletonParents: number[];    // #N, -1 for the root
+    targetUp: number;             // 0..5 = +x,+y,+z,-x,-y,-z (detected unless given)
+    limbEnds: number;             // matched limb ends
   }>;
 }
 
@@ -149,6 +168,10 @@ export type Op = (ctx: OpContext, options: object, buffers: Buffers) => { buffer
 // ---- edit ops (ops/edit.js): positions results carry {positions, rawPositions, rawNormals}
 // ---- debug ops (ops/debug.js; the e2e recovery checks only)
 // debugExhaustMemory {} → {} / {allocatedMB};  debugCrash {} → the worker dies after answering
+// ---- retarget ops (ops/retarget.js; wasm/bind_retarget.cpp)
+// retargetJoints {sourceName, targetName, markersJson?, ...joints job options} + buffers {source, target}
+//          → {positions, skeletonPositions} / {json, names, parents, skeletonParents, skipped,
+//            warnings, targetUp, limbEnds}; retargetPrepare accepts targetJointsJson 'auto'
 // ---- merge ops (ops/merge.js; bindings wasm/bind_merge.cpp: mergeMeshes, cutMesh, boundaryLoops,
 //      exportAssetWithMesh in wasm/bind_mesh.cpp)
 // mergeOpen  {slot, name, cuts?: [{plane: [px,py,pz,nx,ny,nz], keep?} | {disk: [vertex, radius]}]}

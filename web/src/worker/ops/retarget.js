@@ -18,7 +18,7 @@ function session(ctx, id) {
 }
 
 export const ops = {
-  // options: {sourceName, targetName, targetJointsJson?, jointMapJson?, ...any option of the
+  // options: {sourceName, targetName, targetJointsJson? ('auto': fitted, as retargetJoints), jointMapJson?, ...any option of the
   //           retarget job's schema (optionSchema {job: 'retarget'}: clip, fps, first_frame, method, ...)}
   // buffers: {source: bytes, target: bytes}
   retargetPrepare(ctx, options = {}, buffers = {}) {
@@ -46,6 +46,23 @@ export const ops = {
     session(ctx, options.session);
     const r = unwrap(ctx.module.retargetExportGlb(options.session, buffers.positions));
     return { info: {}, buffers: { bytes: r.bytes } };
+  },
+  // Automatic joints for an unrigged target (issue 14; app/joints_job.h).
+  // options: {sourceName, targetName, markersJson? ({"joint": [x, y, z]} pins), ...any option of
+  //           the joints job's schema (optionSchema {job: 'joints'}: resolution, target_up, ...)}
+  // buffers: {source: bytes, target: bytes}
+  // → buffers {positions (#J·3), skeletonPositions (#N·3)} / info {json (give it to
+  //   retargetPrepare as targetJointsJson), names, parents, skeletonParents, skipped, warnings,
+  //   targetUp, limbEnds}
+  retargetJoints(ctx, options = {}, buffers = {}) {
+    const { sourceName, targetName, markersJson, ...jobOptions } = options;
+    const r = unwrap(ctx.module.retargetJoints(toBytes(buffers.source), sourceName || 'source.glb',
+      toBytes(buffers.target), targetName || 'target.glb', markersJson || '', jobOptions, ctx.progress));
+    return {
+      info: { json: r.json, names: r.names, parents: r.parents, skeletonParents: r.skeletonParents,
+        skipped: r.skipped, warnings: r.warnings, targetUp: r.targetUp, limbEnds: r.limbEnds },
+      buffers: { positions: r.positions, skeletonPositions: r.skeletonPositions },
+    };
   },
   retargetDispose(ctx, options = {}) {
     ctx.state.retarget?.delete(options.session);

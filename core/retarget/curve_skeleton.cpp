@@ -1,0 +1,533 @@
+#include "retarget/curve_skeleton.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <string>
+
+namespace mm {
+
+namespace curve_skeleton_detail {
+
+// The 26 neighbour offsets and their lengths, in a fixed order (determinism).
+struct CsNeighbours {
+  int d[26][3];
+  double w[26];
+  CsNeighbours() {
+    int k = 0;
+    for (int z = -1; z <= 1; ++z)
+      for (int y = -1; y <= 1; ++y)
+        for (int x = -1; x <= 1; ++x) {
+          if (!x && !y && !z) continue;
+          d[k][0] = x, d[k][1] = y, d[k][2] = z;
+          w[k] = std::sqrt(double(x * x + y * y + z * z));
+          ++k;
+        }
+  }
+};
+const CsNeighbours& cs_neighbours() {
+  static const CsNeighbours n;
+  return n;
+}
+
+struct CsGrid {
+  int nx, ny, nz;
+  size_t idx(int x, int y, int z) const { return x + size_t(nx) * (y + size_t(ny) * z); }
+  void xyz(size_t i, int* x, int* y, int* z) const {
+    *x = int(i % nx);
+    *y = int((i / nx) % ny);
+    *z = int(i / (size_t(nx) * ny));
+  }
+  bool in(int x, int y, int z) const { return x >= 0 && y >= 0 && z >= 0 && x < nx && y < ny && z < nz; }
+  size_t size() const { return size_t(nx) * ny * nz; }
+};
+
+// Breadth-first layers (26-neighbourhood) from every cell with mask == from_value, up to
+// max_layers; returns the layer of each cell (max_layers + 1 beyond).
+std::vector<int> cs_layers_from(const CsGrid& g, const std::vector<uint8_t>& mask, uint8_t from_value, int max_layers) {
+  const auto& N = cs_neighbours();
+  std::vector<int> layer(g.size(), max_layers + 1);
+  std::deque<size_t> q;
+  for (size_t i = 0; i < g.size(); ++i)
+    if (mask[i] == from_value) layer[i] = 0, q.push_back(i);
+  while (!q.empty()) {
+    const size_t i = q.front();
+    q.pop_front();
+    if (layer[i] >= max_layers) continue;
+    int x, y, z;
+    g.xyz(i, &x, &y, &z);
+    for (int k = 0; k < 26; ++k) {
+      const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
+      if (!g.in(a, b, c)) continue;
+      const size_t j = g.idx(a, b, c);
+      if (layer[j] > layer[i] + 1) layer[j] = layer[i] + 1, q.push_back(j);
+    }
+  }
+  return layer;
+}
+
+// Two-pass chamfer distance (weights 1, √2, √3) from the empty cells, in cells.
+std::vector<float> cs_chamfer_depth(const CsGrid& g, const std::vector<uint8_t>& solid) {
+  const auto& N = cs_neighbours();
+  const float inf = std::numeric_limits<float>::max() / 4;
+  std::vector<float> d(g.size());
+  for (size_t i = 0; i < g.size(); ++i) d[i] = solid[i] ? inf : 0.f;
+  // Forward pass uses the 13 neighbours that precede a cell in scan order; backward the other 13.
+  for (int pass = 0; pass < 2; ++pass) {
+    const int k0 = pass == 0 ? 0 : 13, k1 = pass == 0 ? 13 : 26;
+    for (size_t s = 0; s < g.size(); ++s) {
+      const size_t i = pass == 0 ? s : g.size() - 1 - s;
+      if (!solid[i]) continue;
+      int x, y, z;
+      g.xyz(i, &x, &y, &z);
+      float best = d[i];
+      for (int k = k0; k < k1; ++k) {
+        const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
+        const float dn = g.in(a, b, c) ? d[g.idx(a, b, c)] : 0.f;
+        best = std::min(best, dn + float(N.w[k]));
+      }
+      d[i] = best;
+    }
+  }
+  return d;
+}
+
+// Connected components (26-neighbourhood) of cells with label[i] == value... generalised:
+// cells with key[i] >= 0 join neighbours with the same key. Returns a component id per cell (-1
+// for key < 0) and the number of components; ids follow scan order.
+int cs_components(const CsGrid& g, const std::vector<int>& key, std::vector<int>* comp) {
+  const auto& N = cs_neighbours();
+  comp->assign(g.size(), -1);
+  int n = 0;
+  std::vector<size_t> stack;
+  for (size_t s = 0; s < g.size(); ++s) {
+    if (key[s] < 0 || (*comp)[s] >= 0) continue;
+    (*comp)[s] = n;
+    stack.push_back(s);
+    while (!stack.empty()) {
+      const size_t i = stack.back();
+      stack.pop_back();
+      int x, y, z;
+      g.xyz(i, &x, &y, &z);
+      for (int k = 0; k < 26; ++k) {
+        const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
+        if (!g.in(a, b, c)) continue;
+        const size_t j = g.idx(a, b, c);
+        if ((*comp)[j] < 0 && key[j] == key[i]) (*comp)[j] = n, stack.push_back(j);
+      }
+    }
+    ++n;
+  }
+  return n;
+}
+
+}  // namespace curve_skeleton_detail
+
+bool VoxelSolid::contains(const Eigen::Vector3d& p) const {
+  if (solid.empty()) return false;
+  for (int k = 0; k < 3; ++k) {
+    const double c = (p[k] - grid.lo[k]) / grid.cell;
+    if (!(c >= 0 && c < grid.dims[k])) return false;
+  }
+  return solid[grid.index(grid.coord(p[0], 0), grid.coord(p[1], 1), grid.coord(p[2], 2))] != 0;
+}
+
+double VoxelSolid::depth_at(const Eigen::Vector3d& p) const {
+  if (!contains(p)) return 0;
+  return depth[grid.index(grid.coord(p[0], 0), grid.coord(p[1], 1), grid.coord(p[2], 2))] * grid.cell;
+}
+
+Eigen::Vector3d VoxelSolid::cell_center(size_t i) const {
+  const size_t nx = grid.dims[0], ny = grid.dims[1];
+  const double x = double(i % nx), y = double((i / nx) % ny), z = double(i / (nx * ny));
+  return {grid.lo[0] + (x + 0.5) * grid.cell, grid.lo[1] + (y + 0.5) * grid.cell, grid.lo[2] + (z + 0.5) * grid.cell};
+}
+
+std::vector<std::vector<int>> CurveSkeleton::adjacency() const {
+  std::vector<std::vector<int>> adj(size());
+  for (int i = 0; i < size(); ++i)
+    if (parent[i] >= 0) adj[i].push_back(parent[i]), adj[parent[i]].push_back(i);
+  for (auto& a : adj) std::sort(a.begin(), a.end());
+  return adj;
+}
+
+std::vector<int> CurveSkeleton::leaves() const {
+  std::vector<int> out;
+  const auto adj = adjacency();
+  for (int i = 0; i < size(); ++i)
+    if (adj[i].size() == 1) out.push_back(i);
+  return out;
+}
+
+CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const CurveSkeletonOptions& opt,
+                             const Progress& progress) {
+  using namespace curve_skeleton_detail;
+  CurveSkeleton out;
+  auto fail = [&](StatusCode c, const std::string& m) {
+    out.status = Status::error(c, m);
+    return out;
+  };
+  if (opt.resolution < 16 || opt.resolution > 512)
+    return fail(StatusCode::InvalidArgument, "skeleton resolution must be in [16, 512]");
+  if (!(opt.band_width >= 1.7320508 && opt.band_width <= 64))
+    return fail(StatusCode::InvalidArgument, "skeleton band_width must be in [√3, 64] cells");
+  if (opt.close_holes < 0 || opt.close_holes > 8) return fail(StatusCode::InvalidArgument, "close_holes must be in [0, 8]");
+  if (V.rows() < 3 || F.rows() < 1 || V.cols() != 3 || F.cols() != 3)
+    return fail(StatusCode::InvalidMesh, "the mesh is empty (" + std::to_string(V.rows()) + " vertices, " +
+                                             std::to_string(F.rows()) + " triangles): no skeleton can be extracted");
+  if (!V.allFinite()) return fail(StatusCode::InvalidMesh, "the mesh has non-finite vertex coordinates");
+  if (F.minCoeff() < 0 || F.maxCoeff() >= V.rows())
+    return fail(StatusCode::InvalidMesh, "the mesh has triangle indices outside [0, #V)");
+  const Eigen::RowVector3d lo = V.colwise().minCoeff(), hi = V.colwise().maxCoeff();
+  const double L = (hi - lo).maxCoeff();
+  if (!(L > 0)) return fail(StatusCode::InvalidMesh, "the mesh has no extent");
+  if ((hi - lo).minCoeff() < 1e-6 * L)
+    return fail(StatusCode::InvalidMesh, "the mesh is flat (no volume): a curve skeleton needs a solid shape");
+
+  // 1. Grid with a border of pad cells (the exterior flood starts there).
+  const double h = L / opt.resolution;
+  const int pad = 2 + opt.close_holes;
+  CsGrid g;
+  int dims[3];
+  for (int k = 0; k < 3; ++k) dims[k] = int(std::ceil((hi[k] - lo[k]) / h)) + 1 + 2 * pad;
+  g.nx = dims[0], g.ny = dims[1], g.nz = dims[2];
+  VoxelSolid& vs = out.volume;
+  for (int k = 0; k < 3; ++k) {
+    vs.grid.lo[k] = lo[k] - pad * h;
+    vs.grid.dims[k] = dims[k];
+  }
+  vs.grid.cell = h;
+  auto cell_of = [&](const Eigen::RowVector3d& p, int k) {
+    return std::clamp(int(std::floor((p[k] - vs.grid.lo[k]) / h)), 0, dims[k] - 1);
+  };
+  std::vector<uint8_t> surf(g.size(), 0);
+  for (int f = 0; f < F.rows(); ++f) {
+    if ((f & 4095) == 0 && !progress.update("skeleton: voxels", 0.3 * f / F.rows())) return fail(StatusCode::Cancelled, "cancelled during skeleton: voxels");
+    const Eigen::RowVector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    const double e = std::max({(b - a).norm(), (c - a).norm(), (c - b).norm()});
+    // Samples every ≤ h/3 cover every cell the triangle crosses but for grazed corners, which the
+    // closing (close_holes) seals.
+    const int n = std::max(1, int(std::ceil(3 * e / h)));
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; i + j <= n; ++j) {
+        const Eigen::RowVector3d p = a + (double(i) / n) * (b - a) + (double(j) / n) * (c - a);
+        surf[g.idx(cell_of(p, 0), cell_of(p, 1), cell_of(p, 2))] = 1;
+      }
+  }
+  // Closing: dilate the surface by close_holes, flood the exterior, then erode back.
+  std::vector<uint8_t> wall = surf;
+  if (opt.close_holes > 0) {
+    const std::vector<int> lay = cs_layers_from(g, surf, 1, opt.close_holes);
+    for (size_t i = 0; i < g.size(); ++i) wall[i] = lay[i] <= opt.close_holes;
+  }
+  std::vector<uint8_t> ext(g.size(), 0);
+  {
+    std::vector<size_t> stack;
+    for (size_t i = 0; i < g.size(); ++i) {
+      int x, y, z;
+      g.xyz(i, &x, &y, &z);
+      if ((x == 0 || y == 0 || z == 0 || x == g.nx - 1 || y == g.ny - 1 || z == g.nz - 1) && !wall[i])
+        ext[i] = 1, stack.push_back(i);
+    }
+    const int d6[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    while (!stack.empty()) {
+      const size_t i = stack.back();
+      stack.pop_back();
+      int x, y, z;
+      g.xyz(i, &x, &y, &z);
+      for (const auto& d : d6) {
+        const int a = x + d[0], b = y + d[1], c = z + d[2];
+        if (!g.in(a, b, c)) continue;
+        const size_t j = g.idx(a, b, c);
+        if (!ext[j] && !wall[j]) ext[j] = 1, stack.push_back(j);
+      }
+    }
+  }
+  std::vector<uint8_t>& solid = vs.solid;
+  solid.assign(g.size(), 0);
+  {
+    std::vector<int> lay;
+    if (opt.close_holes > 0) lay = cs_layers_from(g, ext, 1, opt.close_holes);
+    for (size_t i = 0; i < g.size(); ++i)
+      solid[i] = surf[i] || (!ext[i] && (opt.close_holes == 0 || lay[i] > opt.close_holes));
+  }
+  if (!progress.update("skeleton: voxels", 0.4)) return fail(StatusCode::Cancelled, "cancelled during skeleton: voxels");
+
+  // 2. Bridge separate parts to the largest one along the shortest path through empty cells.
+  for (int round = 0; round < 256; ++round) {
+    std::vector<int> key(g.size());
+    for (size_t i = 0; i < g.size(); ++i) key[i] = solid[i] ? 0 : -1;
+    std::vector<int> comp;
+    const int nc = cs_components(g, key, &comp);
+    if (nc == 0) return fail(StatusCode::InvalidMesh, "the mesh encloses no volume at this resolution");
+    if (nc == 1) break;
+    std::vector<size_t> count(nc, 0);
+    for (size_t i = 0; i < g.size(); ++i)
+      if (comp[i] >= 0) ++count[comp[i]];
+    const int main = int(std::max_element(count.begin(), count.end()) - count.begin());
+    // BFS (26-neighbourhood) from the main part through empty cells to the nearest other part.
+    std::vector<int64_t> pred(g.size(), -2);
+    std::deque<size_t> q;
+    for (size_t i = 0; i < g.size(); ++i)
+      if (comp[i] == main) pred[i] = -1, q.push_back(i);
+    int64_t hit = -1;
+    const auto& N = cs_neighbours();
+    while (!q.empty() && hit < 0) {
+      const size_t i = q.front();
+      q.pop_front();
+      int x, y, z;
+      g.xyz(i, &x, &y, &z);
+      for (int k = 0; k < 26 && hit < 0; ++k) {
+        const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
+        if (!g.in(a, b, c)) continue;
+        const size_t j = g.idx(a, b, c);
+        if (pred[j] != -2) continue;
+        pred[j] = int64_t(i);
+        if (comp[j] >= 0) hit = int64_t(j);
+        else q.push_back(j);
+      }
+    }
+    if (hit < 0) break;
+    for (int64_t i = pred[hit]; i >= 0 && comp[i] != main; i = pred[i]) solid[i] = 1;
+    ++out.num_bridges;
+  }
+  vs.depth = cs_chamfer_depth(g, solid);
+  size_t n_solid = 0;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < g.size(); ++i)
+    if (solid[i]) ++n_solid, centroid += vs.cell_center(i);
+  if (n_solid < 64)
+    return fail(StatusCode::InvalidMesh, "the mesh gives only " + std::to_string(n_solid) +
+                                             " solid cells: too thin or too broken for a skeleton");
+  centroid /= double(n_solid);
+  if (!progress.update("skeleton: geodesics", 0.5)) return fail(StatusCode::Cancelled, "cancelled during skeleton: geodesics");
+
+  // 3. Geodesic distance from the seed (solid cell nearest the centroid; ties to the lower index).
+  size_t seed = 0;
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < g.size(); ++i)
+    if (solid[i]) {
+      const double d = (vs.cell_center(i) - centroid).squaredNorm();
+      if (d < best) best = d, seed = i;
+    }
+  std::vector<double> geo(g.size(), std::numeric_limits<double>::infinity());
+  {
+    const auto& N = cs_neighbours();
+    using Item = std::pair<double, size_t>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> pq;
+    geo[seed] = 0;
+    pq.push({0, seed});
+    while (!pq.empty()) {
+      const auto [d, i] = pq.top();
+      pq.pop();
+      if (d > geo[i]) continue;
+      int x, y, z;
+      g.xyz(i, &x, &y, &z);
+      for (int k = 0; k < 26; ++k) {
+        const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
+        if (!g.in(a, b, c)) continue;
+        const size_t j = g.idx(a, b, c);
+        if (!solid[j]) continue;
+        const double nd = d + N.w[k];
+        if (nd < geo[j]) geo[j] = nd, pq.push({nd, j});
+      }
+    }
+  }
+  if (!progress.update("skeleton: bands", 0.75)) return fail(StatusCode::Cancelled, "cancelled during skeleton: bands");
+
+  // 4. Bands and their components: the Reeb graph nodes.
+  std::vector<int> band(g.size(), -1);
+  for (size_t i = 0; i < g.size(); ++i)
+    if (solid[i] && std::isfinite(geo[i])) band[i] = int(geo[i] / opt.band_width);
+  std::vector<int> comp;
+  const int nn = cs_components(g, band, &comp);
+  std::vector<Eigen::Vector3d> sum(nn, Eigen::Vector3d::Zero());
+  std::vector<int> cnt(nn, 0), node_band(nn, 0);
+  std::vector<float> rmax(nn, 0.f);
+  for (size_t i = 0; i < g.size(); ++i) {
+    const int c = comp[i];
+    if (c < 0) continue;
+    sum[c] += vs.cell_center(i);
+    ++cnt[c];
+    node_band[c] = band[i];
+    rmax[c] = std::max(rmax[c], vs.depth[i]);
+  }
+  // Contacts between components of consecutive bands: parent = the lower-band component with most contacts.
+  std::vector<std::vector<std::pair<int, int>>> contacts(nn);  // (lower component, count)
+  {
+    const auto& N = cs_neighbours();
+    for (size_t i = 0; i < g.size(); ++i) {
+      if (comp[i] < 0) continue;
+      int x, y, z;
+      g.xyz(i, &x, &y, &z);
+      for (int k = 0; k < 26; ++k) {
+        const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
+        if (!g.in(a, b, c)) continue;
+        const size_t j = g.idx(a, b, c);
+        if (comp[j] < 0 || band[j] != band[i] - 1) continue;
+        auto& v = contacts[comp[i]];
+        auto it = std::find_if(v.begin(), v.end(), [&](const std::pair<int, int>& e) { return e.first == comp[j]; });
+        if (it == v.end()) v.push_back({comp[j], 1});
+        else ++it->second;
+      }
+    }
+  }
+  std::vector<int> par(nn, -1);
+  const int root = comp[seed];
+  for (int c = 0; c < nn; ++c) {
+    int bestc = -1, bestn = 0;
+    for (const auto& [o, n] : contacts[c])
+      if (n > bestn || (n == bestn && o < bestc)) bestn = n, bestc = o;
+    par[c] = bestc;
+  }
+  par[root] = -1;
+  // Components not linked to the root (cannot happen for band_width ≥ √3) are dropped.
+  std::vector<Eigen::Vector3d> pos(nn);
+  for (int c = 0; c < nn; ++c) pos[c] = sum[c] / std::max(1, cnt[c]);
+
+  // 5. Prune short leaf branches bottom-up: process nodes by decreasing band.
+  std::vector<int> order(nn);
+  for (int c = 0; c < nn; ++c) order[c] = c;
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return node_band[a] > node_band[b]; });
+  std::vector<std::vector<int>> kids(nn);
+  for (int c = 0; c < nn; ++c)
+    if (par[c] >= 0) kids[par[c]].push_back(c);
+  std::vector<double> reach(nn, 0.0);  // longest path length from the node down to a leaf of its subtree
+  std::vector<uint8_t> alive(nn, 1);
+  const double prune = opt.prune_length * L;
+  std::function<void(int)> kill = [&](int c) {
+    alive[c] = 0;
+    for (int k : kids[c]) kill(k);
+  };
+  for (int c : order) {
+    double longest = -1;
+    int keep = -1;
+    for (int k : kids[c]) {
+      const double len = reach[k] + (pos[k] - pos[c]).norm();
+      if (len > longest) longest = len, keep = k;
+    }
+    // A side branch is pruned when shorter than prune_length or than the local radius (bumps,
+    // and the fragments a band's ring breaks into where a limb's cap is cut obliquely); the
+    // limb's own tip likewise when shorter than the radius (the node then ends the limb).
+    // The local radius: depth of the solid at the node's centroid (a band component near the
+    // surface, where a blocky part's corners split off, has a small own depth but sits in a thick part).
+    const double r_here = std::max<double>(rmax[c] + 0.5, vs.depth[vs.grid.index(vs.grid.coord(pos[c][0], 0), vs.grid.coord(pos[c][1], 1),
+                                                                          vs.grid.coord(pos[c][2], 2))]) * h;
+    double kept = 0;
+    for (int k : kids[c]) {
+      const double len = reach[k] + (pos[k] - pos[c]).norm();
+      const bool split = kids[c].size() >= 2, side = k != keep;
+      if (split && ((side && len < std::max(prune, opt.prune_radius * r_here)) || (!side && len < opt.prune_radius * r_here)))
+        kill(k);
+      else kept = std::max(kept, len);
+    }
+    (void)longest;
+    reach[c] = kept;
+  }
+  // The root's side branches: the root is usually mid-body, so its shortest remaining branch
+  // can also be a stub; the rule above handles it as for any junction.
+  std::vector<int> reachable(nn, 0);
+  for (int c : std::vector<int>(order.rbegin(), order.rend()))  // increasing band: parents first
+    reachable[c] = c == root ? 1 : (par[c] >= 0 && reachable[par[c]] && alive[c]);
+  std::vector<int> new_id(nn, -1);
+  int m = 0;
+  for (int c = 0; c < nn; ++c)
+    if (reachable[c]) new_id[c] = m++;
+  out.nodes.resize(m, 3);
+  out.radius.resize(m);
+  out.parent.assign(m, -1);
+  for (int c = 0; c < nn; ++c) {
+    if (new_id[c] < 0) continue;
+    out.nodes.row(new_id[c]) = pos[c].transpose();
+    out.radius[new_id[c]] = (rmax[c] + 0.5) * h;
+    out.parent[new_id[c]] = c == root ? -1 : new_id[par[c]];
+  }
+  out.root = new_id[root];
+  // Limb tips: the last bands of a limb are rings on its cap whose centroids drift toward the
+  // cells the (discrete) geodesic reaches last, so the chain bends off the axis in its last
+  // radius. Each tip chain is cut back by one local radius and extended straight along the
+  // remaining chain's direction to where it leaves the solid.
+  {
+    const auto adj0 = out.adjacency();
+    std::vector<uint8_t> drop(m, 0);
+    for (int leaf = 0; leaf < m; ++leaf) {
+      if (adj0[leaf].size() != 1 || leaf == out.root) continue;
+      std::vector<int> chain = {leaf};
+      double arc = 0, rmax_chain = out.radius[leaf];
+      int a = leaf;
+      while (out.parent[a] >= 0 && adj0[out.parent[a]].size() == 2 && out.parent[a] != out.root) {
+        arc += (out.nodes.row(out.parent[a]) - out.nodes.row(a)).norm();
+        a = out.parent[a];
+        chain.push_back(a);
+        rmax_chain = std::max(rmax_chain, out.radius[a]);
+        if (arc >= rmax_chain) break;
+      }
+      if (chain.size() < 2 || arc < rmax_chain) continue;  // short tips are left as they are
+      // Direction from one more radius up the chain to the anchor a.
+      int b = a;
+      double back = 0;
+      while (out.parent[b] >= 0 && back < out.radius[a]) {
+        back += (out.nodes.row(out.parent[b]) - out.nodes.row(b)).norm();
+        b = out.parent[b];
+      }
+      Eigen::Vector3d d = (out.nodes.row(a) - out.nodes.row(b)).transpose();
+      if (d.norm() <= 0) continue;
+      d.normalize();
+      Eigen::Vector3d e = out.nodes.row(a).transpose();
+      for (int step = 0; step < 4 * opt.resolution && vs.contains(e + 0.5 * h * d); ++step) e += 0.5 * h * d;
+      for (size_t k = 1; k + 1 < chain.size(); ++k) drop[chain[k]] = 1;
+      out.nodes.row(leaf) = e.transpose();
+      out.radius[leaf] = 0.5 * h;
+      out.parent[leaf] = a;
+    }
+    // The first bands are concentric shells around the seed with (nearly) the same centroid: a
+    // root with a single child that close is dropped, and so on down the chain.
+    int new_root = out.root;
+    for (;;) {
+      std::vector<int> kids_of_root;
+      for (int i = 0; i < m; ++i)
+        if (out.parent[i] == new_root && !drop[i]) kids_of_root.push_back(i);
+      if (kids_of_root.size() != 1) break;
+      const int kid = kids_of_root[0];
+      if ((out.nodes.row(kid) - out.nodes.row(new_root)).norm() > 0.5 * out.radius[new_root]) break;
+      drop[new_root] = 1;
+      out.parent[kid] = -1;
+      new_root = kid;
+    }
+    out.root = new_root;
+    std::vector<int> id(m, -1);
+    int k = 0;
+    for (int i = 0; i < m; ++i)
+      if (!drop[i]) id[i] = k++;
+    Eigen::MatrixXd P(k, 3);
+    Eigen::VectorXd R(k);
+    std::vector<int> par2(k, -1);
+    for (int i = 0; i < m; ++i) {
+      if (drop[i]) continue;
+      P.row(id[i]) = out.nodes.row(i);
+      R[id[i]] = out.radius[i];
+      par2[id[i]] = out.parent[i] >= 0 ? id[out.parent[i]] : -1;
+    }
+    out.nodes = P;
+    out.radius = R;
+    out.parent = par2;
+    out.root = id[out.root];
+    m = k;
+  }
+  // Smooth chain nodes (degree 2): removes the stair-steps of the band centroids.
+  const auto adj = out.adjacency();
+  for (int it = 0; it < opt.smoothing_iterations; ++it) {
+    Eigen::MatrixXd P = out.nodes;
+    for (int i = 0; i < m; ++i)
+      if (adj[i].size() == 2) P.row(i) = 0.5 * out.nodes.row(i) + 0.25 * (out.nodes.row(adj[i][0]) + out.nodes.row(adj[i][1]));
+    out.nodes = P;
+  }
+  if (!out.nodes.allFinite()) return fail(StatusCode::NumericalError, "the skeleton has non-finite nodes");
+  progress.update("skeleton", 1.0);
+  return out;
+}
+
+}  // namespace mm

@@ -1,0 +1,580 @@
+#include "retarget/joint_fitting.h"
+
+#include <algorithm>
+#include <functional>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "spatial/triangle_bvh.h"
+
+namespace mm {
+
+namespace joint_fitting_detail {
+
+Eigen::Vector3d jf_axis(int a) {
+  Eigen::Vector3d u = Eigen::Vector3d::Zero();
+  u[a % 3] = a < 3 ? 1.0 : -1.0;
+  return u;
+}
+
+const char* jf_axis_name(int a) {
+  static const char* names[6] = {"+x", "+y", "+z", "-x", "-y", "-z"};
+  return names[a];
+}
+
+// The 24 proper axis-aligned rotations, in a fixed order.
+std::vector<Eigen::Matrix3d> jf_rotations() {
+  std::vector<Eigen::Matrix3d> out;
+  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (const auto& p : perms)
+    for (int s = 0; s < 8; ++s) {
+      Eigen::Matrix3d R = Eigen::Matrix3d::Zero();
+      for (int i = 0; i < 3; ++i) R(i, p[i]) = (s >> i) & 1 ? -1.0 : 1.0;
+      if (R.determinant() > 0) out.push_back(R);
+    }
+  return out;
+}
+
+// Normalised frame of a point set seen with up vector u: origin at the bottom centre of the
+// bounding box, unit = the extent along u.
+struct JfFrame {
+  Eigen::Vector3d o = Eigen::Vector3d::Zero();
+  double H = 1;
+  Eigen::Vector3d u = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d operator()(const Eigen::Vector3d& p) const { return (p - o) / H; }
+  double height(const Eigen::Vector3d& p) const { return (p - o).dot(u) / H; }
+};
+
+JfFrame jf_frame(const Eigen::MatrixXd& P, const Eigen::Vector3d& u) {
+  JfFrame f;
+  const Eigen::Vector3d lo = P.colwise().minCoeff().transpose(), hi = P.colwise().maxCoeff().transpose();
+  const double ext = (hi - lo).cwiseAbs().dot(u.cwiseAbs());
+  f.u = u;
+  f.H = ext > 0 ? ext : 1.0;
+  f.o = 0.5 * (lo + hi) - 0.5 * ext * u;
+  return f;
+}
+
+// A rooted tree view of a curve skeleton with paths, lowest common ancestors and medians.
+struct JfTree {
+  const CurveSkeleton* s = nullptr;
+  std::vector<int> depth;
+  explicit JfTree(const CurveSkeleton& sk) : s(&sk), depth(sk.size(), 0) {
+    for (int i = 0; i < sk.size(); ++i) {
+      int d = 0;
+      for (int p = sk.parent[i]; p >= 0; p = sk.parent[p]) ++d;
+      depth[i] = d;
+    }
+  }
+  int lca(int a, int b) const {
+    while (depth[a] > depth[b]) a = s->parent[a];
+    while (depth[b] > depth[a]) b = s->parent[b];
+    while (a != b) a = s->parent[a], b = s->parent[b];
+    return a;
+  }
+  int median(int a, int b, int c) const {
+    const int x = lca(a, b), y = lca(a, c), z = lca(b, c);
+    int m = x;
+    if (depth[y] > depth[m]) m = y;
+    if (depth[z] > depth[m]) m = z;
+    return m;
+  }
+  std::vector<int> path(int a, int b) const {
+    const int l = lca(a, b);
+    std::vector<int> up, down;
+    for (int x = a; x != l; x = s->parent[x]) up.push_back(x);
+    up.push_back(l);
+    for (int x = b; x != l; x = s->parent[x]) down.push_back(x);
+    up.insert(up.end(), down.rbegin(), down.rend());
+    return up;
+  }
+  Eigen::Vector3d pos(int i) const { return s->nodes.row(i).transpose(); }
+};
+
+// A path with cumulative arc lengths.
+struct JfPath {
+  std::vector<int> nodes;
+  std::vector<double> arc;
+  double length() const { return arc.empty() ? 0 : arc.back(); }
+  int index_of(int node) const {
+    for (size_t i = 0; i < nodes.size(); ++i)
+      if (nodes[i] == node) return int(i);
+    return -1;
+  }
+};
+
+JfPath jf_path(const JfTree& t, int a, int b) {
+  JfPath p;
+  p.nodes = t.path(a, b);
+  p.arc.assign(p.nodes.size(), 0.0);
+  for (size_t i = 1; i < p.nodes.size(); ++i) p.arc[i] = p.arc[i - 1] + (t.pos(p.nodes[i]) - t.pos(p.nodes[i - 1])).norm();
+  return p;
+}
+
+// Point and radius at arc length s along a path (clamped).
+void jf_point_at(const JfTree& t, const JfPath& p, double s, Eigen::Vector3d* x, double* r) {
+  s = std::clamp(s, 0.0, p.length());
+  size_t i = 0;
+  while (i + 2 < p.nodes.size() && p.arc[i + 1] < s) ++i;
+  if (p.nodes.size() == 1) {
+    *x = t.pos(p.nodes[0]);
+    *r = t.s->radius[p.nodes[0]];
+    return;
+  }
+  const double len = p.arc[i + 1] - p.arc[i];
+  const double u = len > 0 ? std::clamp((s - p.arc[i]) / len, 0.0, 1.0) : 0.0;
+  *x = (1 - u) * t.pos(p.nodes[i]) + u * t.pos(p.nodes[i + 1]);
+  *r = (1 - u) * t.s->radius[p.nodes[i]] + u * t.s->radius[p.nodes[i + 1]];
+}
+
+// Solid cell centres, every stride-th, as rows.
+Eigen::MatrixXd jf_solid_samples(const VoxelSolid& v, int target_count) {
+  size_t n = 0;
+  for (uint8_t s : v.solid) n += s;
+  const size_t stride = std::max<size_t>(1, n / std::max(1, target_count));
+  std::vector<Eigen::Vector3d> pts;
+  size_t k = 0;
+  for (size_t i = 0; i < v.solid.size(); ++i)
+    if (v.solid[i] && (k++ % stride) == 0) pts.push_back(v.cell_center(i));
+  Eigen::MatrixXd P(pts.size(), 3);
+  for (size_t i = 0; i < pts.size(); ++i) P.row(i) = pts[i].transpose();
+  return P;
+}
+
+double jf_chamfer(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
+  auto one_way = [](const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) {
+    double sum = 0;
+    for (int i = 0; i < X.rows(); ++i) sum += std::sqrt((Y.rowwise() - X.row(i)).rowwise().squaredNorm().minCoeff());
+    return sum / std::max<Eigen::Index>(1, X.rows());
+  };
+  return 0.5 * (one_way(A, B) + one_way(B, A));
+}
+
+struct JfLeafMatch {
+  std::vector<std::pair<int, int>> pairs;  // (source leaf node, target leaf node)
+  double cost = 0;
+};
+
+// Greedy matching of normalised limb ends (closest pairs first, ties to the lower indices).
+JfLeafMatch jf_match_leaves(const std::vector<Eigen::Vector3d>& S, const std::vector<int>& s_nodes,
+                            const std::vector<Eigen::Vector3d>& T, const std::vector<int>& t_nodes, double tol) {
+  struct Cand {
+    double d;
+    int i, j;
+  };
+  std::vector<Cand> c;
+  // S, T: two points per limb end (end, back point); the cost is their mean distance.
+  for (size_t i = 0; i < S.size() / 2; ++i)
+    for (size_t j = 0; j < T.size() / 2; ++j)
+      c.push_back({0.5 * ((S[2 * i] - T[2 * j]).norm() + (S[2 * i + 1] - T[2 * j + 1]).norm()), int(i), int(j)});
+  std::stable_sort(c.begin(), c.end(), [](const Cand& a, const Cand& b) { return a.d < b.d; });
+  std::vector<uint8_t> us(S.size() / 2, 0), ut(T.size() / 2, 0);
+  JfLeafMatch m;
+  for (const Cand& x : c) {
+    if (x.d > tol || us[x.i] || ut[x.j]) continue;
+    us[x.i] = ut[x.j] = 1;
+    m.pairs.push_back({s_nodes[x.i], t_nodes[x.j]});
+    m.cost += x.d;
+  }
+  for (size_t i = 0; i < us.size(); ++i)
+    if (!us[i]) m.cost += tol;
+  return m;
+}
+
+std::string jf_join(const std::vector<std::string>& v, size_t limit = 10) {
+  std::string s;
+  for (size_t i = 0; i < v.size() && i < limit; ++i) s += (i ? ", " : "") + v[i];
+  if (v.size() > limit) s += ", ... (" + std::to_string(v.size()) + " in all)";
+  return s;
+}
+
+}  // namespace joint_fitting_detail
+
+JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, const JointSet& source_joints,
+                          const Eigen::MatrixXd& Vt, const Eigen::MatrixXi& Ft, const std::vector<JointMarker>& markers,
+                          const JointFitOptions& opt, const Progress& progress) {
+  using namespace joint_fitting_detail;
+  JointFitResult r;
+  auto fail = [&](StatusCode c, const std::string& m) {
+    r.status = Status::error(c, m);
+    return r;
+  };
+  if (opt.source_up < 0 || opt.source_up > 5 || opt.target_up < -1 || opt.target_up > 5 || opt.source_front < 0 ||
+      opt.source_front > 5 || opt.target_front < -1 || opt.target_front > 5 || opt.source_up % 3 == opt.source_front % 3 ||
+      (opt.target_up >= 0 && opt.target_front >= 0 && opt.target_up % 3 == opt.target_front % 3))
+    return fail(StatusCode::InvalidArgument, "up axes must be -1 (target: detect) or 0..5 (+x, +y, +z, -x, -y, -z)");
+  if (source_joints.size() < 2) return fail(StatusCode::InvalidArgument, "the source has fewer than 2 joints");
+  r.source_skeleton = curve_skeleton(Vs, Fs, opt.skeleton, progress.sub(0, 0.45));
+  if (!r.source_skeleton.status.ok())
+    return fail(r.source_skeleton.status.code, "source skeleton: " + r.source_skeleton.status.message);
+  r.target_skeleton = curve_skeleton(Vt, Ft, opt.skeleton, progress.sub(0.45, 0.9));
+  if (!r.target_skeleton.status.ok())
+    return fail(r.target_skeleton.status.code, "target skeleton: " + r.target_skeleton.status.message);
+  const CurveSkeleton& SS = r.source_skeleton;
+  const CurveSkeleton& TS = r.target_skeleton;
+  const JfTree st(SS), tt(TS);
+  const std::vector<int> s_leaves = SS.leaves(), t_leaves = TS.leaves();
+  if (s_leaves.size() < 2 || t_leaves.size() < 2)
+    return fail(StatusCode::InvalidMesh, std::string("the ") + (s_leaves.size() < 2 ? "source" : "target") +
+                                             " skeleton has fewer than 2 limb ends: the mesh is too broken or too "
+                                             "blob-like for automatic joints; place the joints with markers or a JSON file");
+
+  // Source joints inside the source surface.
+  TriangleBvh bvh_s(Vs, Fs), bvh_t(Vt, Ft);
+  const double tol_s = opt.inside_tolerance * (Vs.colwise().maxCoeff() - Vs.colwise().minCoeff()).norm();
+  const double tol_t = opt.inside_tolerance * (Vt.colwise().maxCoeff() - Vt.colwise().minCoeff()).norm();
+  auto inside_s = [&](const Eigen::Vector3d& p) { return bvh_s.closest_point(p).sq_distance <= tol_s * tol_s || bvh_s.inside(p); };
+  auto inside_t = [&](const Eigen::Vector3d& p) { return bvh_t.closest_point(p).sq_distance <= tol_t * tol_t || bvh_t.inside(p); };
+  std::vector<int> used;
+  for (int j = 0; j < source_joints.size(); ++j) {
+    if (inside_s(source_joints.P.row(j).transpose())) used.push_back(j);
+    else r.skipped.push_back(source_joints.names[j]);
+  }
+  if (used.size() < 2) return fail(StatusCode::InvalidArgument, "fewer than 2 source joints lie inside the source surface");
+
+  // 2. Up axes.
+  const Eigen::Vector3d us = jf_axis(opt.source_up);
+  Eigen::MatrixXd Ls(s_leaves.size(), 3), Lt(t_leaves.size(), 3);
+  for (size_t i = 0; i < s_leaves.size(); ++i) Ls.row(i) = SS.nodes.row(s_leaves[i]);
+  for (size_t i = 0; i < t_leaves.size(); ++i) Lt.row(i) = TS.nodes.row(t_leaves[i]);
+  int up_t = opt.target_up;
+  if (up_t < 0) {
+    int best = -1;
+    for (int a : {1, 2, 0, 4, 5, 3}) {
+      const JfFrame f = jf_frame(Vt, jf_axis(a));
+      int n = 0;
+      for (int i = 0; i < Lt.rows(); ++i) n += f.height(Lt.row(i).transpose()) < opt.ground_band;
+      if (n > best) best = n, up_t = a;
+    }
+  }
+  r.target_up = up_t;
+  const Eigen::Vector3d ut = jf_axis(up_t);
+
+  // 3–4. Facing: 4 turns about up, scored by chamfer of the solids + limb-end matching.
+  if (!progress.update("fitting", 0.9)) return fail(StatusCode::Cancelled, "cancelled during fitting");
+  const JfFrame fs = jf_frame(Vs, us);
+  const Eigen::MatrixXd Ps = jf_solid_samples(SS.volume, 1200), Pt = jf_solid_samples(TS.volume, 1200);
+  Eigen::MatrixXd Ps_n(Ps.rows(), 3);
+  for (int i = 0; i < Ps.rows(); ++i) Ps_n.row(i) = fs(Ps.row(i).transpose()).transpose();
+  // Limb-end descriptors: the end and the point back_length × height up its path toward the
+  // root (elbow/knee-ish), so that an A-pose and a T-pose still pair hands with hands.
+  auto back_point = [&](const JfTree& tree, int leaf, double length) {
+    int a = leaf;
+    double arc = 0;
+    while (tree.s->parent[a] >= 0 && arc < length) {
+      arc += (tree.pos(tree.s->parent[a]) - tree.pos(a)).norm();
+      a = tree.s->parent[a];
+    }
+    return tree.pos(a);
+  };
+  std::vector<Eigen::Vector3d> Sn;
+  for (int i = 0; i < Ls.rows(); ++i) {
+    Sn.push_back(fs(Ls.row(i).transpose()));
+    Sn.push_back(fs(back_point(st, s_leaves[i], opt.back_length * fs.H)));
+  }
+  double best_cost = std::numeric_limits<double>::infinity();
+  JfLeafMatch match;
+  JfFrame ft;
+  for (const Eigen::Matrix3d& R : jf_rotations()) {
+    if ((R * ut - us).norm() > 1e-9) continue;
+    if (opt.target_front >= 0 && (R * jf_axis(opt.target_front) - jf_axis(opt.source_front)).norm() > 1e-9) continue;
+    const Eigen::MatrixXd Vr = Vt * R.transpose();
+    const JfFrame f = jf_frame(Vr, us);
+    Eigen::MatrixXd Pt_n(Pt.rows(), 3);
+    for (int i = 0; i < Pt.rows(); ++i) Pt_n.row(i) = f(R * Pt.row(i).transpose()).transpose();
+    std::vector<Eigen::Vector3d> Tn;
+    for (int i = 0; i < Lt.rows(); ++i) {
+      Tn.push_back(f(R * Lt.row(i).transpose()));
+      Tn.push_back(f(R * back_point(tt, t_leaves[i], opt.back_length * f.H)));
+    }
+    JfLeafMatch m = jf_match_leaves(Sn, s_leaves, Tn, t_leaves, opt.leaf_tolerance);
+    const double cost = jf_chamfer(Ps_n, Pt_n) + m.cost / std::max<size_t>(1, s_leaves.size());
+    if (cost < best_cost) best_cost = cost, match = m, r.rotation = R, ft = f;
+  }
+  const Eigen::Matrix3d R = r.rotation;
+  r.limb_ends = match.pairs;
+  // Limbs on the ground: ground limb ends grouped when their paths meet low (the corners of one
+  // blocky boot meet inside the foot; two feet meet at the crotch or the body).
+  auto ground_limbs = [&](const JfTree& tree, const std::vector<int>& leaves, const std::function<double(int)>& height) {
+    std::vector<int> g;
+    for (int l : leaves)
+      if (height(l) < opt.ground_band) g.push_back(l);
+    std::vector<int> group(g.size());
+    for (size_t i = 0; i < g.size(); ++i) group[i] = int(i);
+    for (size_t i = 0; i < g.size(); ++i)
+      for (size_t j = i + 1; j < g.size(); ++j)
+        if (height(tree.lca(g[i], g[j])) < opt.ground_band) {
+          const int a = group[i], b = group[j];
+          for (int& x : group)
+            if (x == b) x = a;
+        }
+    std::sort(group.begin(), group.end());
+    return int(std::unique(group.begin(), group.end()) - group.begin());
+  };
+  r.source_ground = ground_limbs(st, s_leaves, [&](int n) { return fs.height(st.pos(n)); });
+  r.target_ground = ground_limbs(tt, t_leaves, [&](int n) { return ft.height(R * tt.pos(n)); });
+
+  // Closest points of the used source joints on the whole source skeleton, to find which limb
+  // ends carry joints (an edge (u, parent u) whose subtree below holds a single leaf is that leaf's).
+  const int ns = SS.size();
+  std::vector<int> leaves_below(ns, 0), only_leaf(ns, -1);
+  {
+    std::vector<int> order(ns);
+    for (int i = 0; i < ns; ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return st.depth[a] > st.depth[b]; });
+    const auto adj = SS.adjacency();
+    for (int i : order) {
+      if (adj[i].size() == 1 && i != SS.root) leaves_below[i] += 1;
+      if (SS.parent[i] >= 0) leaves_below[SS.parent[i]] += leaves_below[i];
+    }
+    for (int i = 0; i < ns; ++i)
+      if (adj[i].size() == 1 && i != SS.root)
+        for (int x = i; x >= 0 && leaves_below[x] == 1; x = SS.parent[x]) only_leaf[x] = i;
+  }
+  auto closest_on_edges = [&](const Eigen::Vector3d& p, const std::vector<int>& edges, int* edge, double* t) {
+    double best = std::numeric_limits<double>::infinity();
+    Eigen::Vector3d q = st.pos(SS.root);
+    *edge = -1, *t = 0;
+    for (int u : edges) {
+      const Eigen::Vector3d a = st.pos(u), b = st.pos(SS.parent[u]);
+      const double l2 = (b - a).squaredNorm();
+      const double x = l2 > 0 ? std::clamp((p - a).dot(b - a) / l2, 0.0, 1.0) : 0.0;
+      const Eigen::Vector3d c = a + x * (b - a);
+      const double d = (p - c).squaredNorm();
+      if (d < best) best = d, q = c, *edge = u, *t = x;
+    }
+    return q;
+  };
+  std::vector<int> all_edges;
+  for (int i = 0; i < ns; ++i)
+    if (SS.parent[i] >= 0) all_edges.push_back(i);
+  std::map<int, std::vector<std::string>> joints_on_leaf;
+  for (int j : used) {
+    int e;
+    double t;
+    closest_on_edges(source_joints.P.row(j).transpose(), all_edges, &e, &t);
+    if (e >= 0 && only_leaf[e] >= 0) joints_on_leaf[only_leaf[e]].push_back(source_joints.names[j]);
+  }
+  std::map<int, int> matched_s;  // source leaf node → index in match.pairs
+  for (size_t k = 0; k < match.pairs.size(); ++k) matched_s[match.pairs[k].first] = int(k);
+  if (opt.check_topology) {
+    std::vector<std::string> lost;
+    // An unmatched end carrying joints is lost unless it is a sub-branch of a matched limb
+    // (another finger of a matched hand): path length to a matched end < back_length × height.
+    for (const auto& [leaf, names] : joints_on_leaf) {
+      if (matched_s.count(leaf) || names.size() < 2) continue;
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const auto& pr : match.pairs) {
+        const int l = st.lca(leaf, pr.first);
+        const double d = (st.pos(leaf) - st.pos(l)).norm() + (st.pos(pr.first) - st.pos(l)).norm();
+        nearest = std::min(nearest, d);
+      }
+      if (nearest > opt.back_length * fs.H) lost.push_back(names.back());
+    }
+    const std::string counts = "the source has " + std::to_string(s_leaves.size()) + " limb ends (" +
+                               std::to_string(r.source_ground) + " on the ground), the target " +
+                               std::to_string(t_leaves.size()) + " (" + std::to_string(r.target_ground) +
+                               " on the ground, up " + jf_axis_name(up_t) + ")";
+    if (std::abs(r.source_ground - r.target_ground) >= 2)
+      return fail(StatusCode::InvalidArgument,
+                  "topology mismatch: the source skeleton stands on " + std::to_string(r.source_ground) +
+                      " limbs and the target on " + std::to_string(r.target_ground) +
+                      " (e.g. a biped skeleton on a quadruped); " + counts +
+                      ". Use a source character of the target's kind, or give the target's up axis (--target-up) "
+                      "if it was detected wrongly");
+    if (!lost.empty())
+      return fail(StatusCode::InvalidArgument,
+                  "topology mismatch: no limb of the target matches the source's chain ending at " + jf_join(lost) +
+                      "; " + counts + ". Use a source of the target's kind, or pin those joints with markers");
+  }
+  if (match.pairs.size() < 2)
+    return fail(StatusCode::InvalidArgument, "fewer than 2 limb ends of the target match the source's: place the joints with markers");
+
+  // 5. Paths between matched ends on both sides, and their branch points.
+  const int nm = int(match.pairs.size());
+  struct PairPaths {
+    int a, b;
+    JfPath ps, pt;
+  };
+  std::vector<PairPaths> pairs;
+  std::vector<uint8_t> on_matched(ns, 0);
+  for (int a = 0; a < nm; ++a)
+    for (int b = a + 1; b < nm; ++b) {
+      PairPaths pp{a, b, jf_path(st, match.pairs[a].first, match.pairs[b].first),
+                   jf_path(tt, match.pairs[a].second, match.pairs[b].second)};
+      for (size_t i = 0; i + 1 < pp.ps.nodes.size(); ++i) {
+        const int x = pp.ps.nodes[i], y = pp.ps.nodes[i + 1];
+        on_matched[SS.parent[x] == y ? x : y] = 1;
+      }
+      pairs.push_back(std::move(pp));
+    }
+  std::vector<int> matched_edges;
+  for (int i = 0; i < ns; ++i)
+    if (on_matched[i] && SS.parent[i] >= 0) matched_edges.push_back(i);
+  // Arc position of a branch label on a path: −1 = the path's start, −2 = its end, c = median with end c.
+  auto label_arc = [&](const JfTree& tree, const JfPath& p, int a, int b, int c, bool source_side) {
+    if (c == -1) return 0.0;
+    if (c == -2) return p.length();
+    const auto& mp = match.pairs;
+    const int m = source_side ? tree.median(mp[a].first, mp[b].first, mp[c].first)
+                              : tree.median(mp[a].second, mp[b].second, mp[c].second);
+    const int i = p.index_of(m);
+    return i >= 0 ? p.arc[i] : 0.0;
+  };
+
+  JointSet& out = r.joints;
+  std::vector<int> out_index(source_joints.size(), -1);
+  std::vector<std::string> outside;
+  for (int j : used) {
+    const Eigen::Vector3d pj = source_joints.P.row(j).transpose();
+    int e;
+    double t;
+    const Eigen::Vector3d q = closest_on_edges(pj, matched_edges, &e, &t);
+    const double rq = (1 - t) * SS.radius[e] + t * SS.radius[SS.parent[e]];
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    double rsum = 0;
+    int n = 0;
+    for (const PairPaths& pp : pairs) {
+      // Arc length of q along this source path, if the path holds edge e.
+      int i = -1;
+      for (size_t k = 0; k + 1 < pp.ps.nodes.size(); ++k)
+        if ((pp.ps.nodes[k] == e && pp.ps.nodes[k + 1] == SS.parent[e]) ||
+            (pp.ps.nodes[k + 1] == e && pp.ps.nodes[k] == SS.parent[e])) {
+          i = int(k);
+          break;
+        }
+      if (i < 0) continue;
+      const double len = pp.ps.arc[i + 1] - pp.ps.arc[i];
+      const double s = pp.ps.arc[i] + (pp.ps.nodes[i] == e ? t : 1 - t) * len;
+      // Branch points grouped by position along the source path.
+      std::vector<std::pair<double, std::vector<int>>> groups;
+      std::vector<int> labels = {-1, -2};
+      for (int c = 0; c < nm; ++c)
+        if (c != pp.a && c != pp.b) labels.push_back(c);
+      for (int c : labels) {
+        const double x = label_arc(st, pp.ps, pp.a, pp.b, c, true);
+        auto it = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return std::abs(g.first - x) < 1e-12; });
+        if (it == groups.end()) groups.push_back({x, {c}});
+        else it->second.push_back(c);
+      }
+      std::stable_sort(groups.begin(), groups.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+      size_t k = 0;
+      while (k + 2 < groups.size() && groups[k + 1].first <= s) ++k;
+      const double span = groups[k + 1].first - groups[k].first;
+      const double tau = span > 0 ? std::clamp((s - groups[k].first) / span, 0.0, 1.0) : 0.0;
+      auto target_arc = [&](const std::vector<int>& g) {
+        double x = 0;
+        for (int c : g) x += label_arc(tt, pp.pt, pp.a, pp.b, c, false);
+        return x / g.size();
+      };
+      const double lo = target_arc(groups[k].second), hi = target_arc(groups[k + 1].second);
+      Eigen::Vector3d x;
+      double rx;
+      jf_point_at(tt, pp.pt, lo + tau * (hi - lo), &x, &rx);
+      sum += x, rsum += rx, ++n;
+    }
+    if (n == 0) continue;  // cannot happen: e lies on some matched path
+    const Eigen::Vector3d qt = sum / n;
+    const double rt = rsum / n;
+    const double scale = std::clamp(rq > 0 ? rt / rq : 1.0, 0.25, 4.0);
+    const Eigen::Vector3d off = R.transpose() * (pj - q) * scale;
+    // 6. Pull toward the skeleton point until inside.
+    Eigen::Vector3d p = qt + off;
+    for (int it = 0; it < 6 && !inside_t(p); ++it) p = qt + off * std::pow(0.5, it + 1);
+    if (!inside_t(p)) p = qt;
+    if (!inside_t(p)) {
+      // Between parts (a robot's gap at a knee): just inside the nearest surface.
+      const ClosestPoint c = bvh_t.closest_point(p);
+      if (c.face >= 0) {
+        const Eigen::Vector3d a = Vt.row(Ft(c.face, 0)), b = Vt.row(Ft(c.face, 1)), d = Vt.row(Ft(c.face, 2));
+        const Eigen::Vector3d n = (b - a).cross(d - a).normalized();
+        for (double side : {1.0, -1.0}) {
+          const Eigen::Vector3d x = c.point - side * 0.5 * tol_t * n;
+          if (n.allFinite() && bvh_t.inside(x)) {
+            p = x;
+            break;
+          }
+        }
+      }
+    }
+    if (!inside_t(p)) outside.push_back(source_joints.names[j]);
+    out_index[j] = out.size();
+    out.names.push_back(source_joints.names[j]);
+    out.P.conservativeResize(out.size(), 3);
+    out.P.row(out.size() - 1) = p.transpose();
+  }
+  // Hierarchy: nearest placed ancestor.
+  for (int j : used) {
+    if (out_index[j] < 0) continue;
+    int p = static_cast<int>(source_joints.parent.size()) == source_joints.size() ? source_joints.parent[j] : -1;
+    while (p >= 0 && out_index[p] < 0) p = source_joints.parent[p];
+    out.parent.push_back(p >= 0 ? out_index[p] : -1);
+  }
+
+  // Markers: pin, and drag chain neighbours within marker_reach bones.
+  if (!markers.empty()) {
+    std::vector<int> pinned(out.size(), 0);
+    std::vector<Eigen::Vector3d> delta(out.size(), Eigen::Vector3d::Zero());
+    for (const JointMarker& m : markers) {
+      const int k = out.find(m.name);
+      if (k < 0) {
+        const bool exists = source_joints.find(m.name) >= 0;
+        return fail(StatusCode::InvalidArgument,
+                    "marker '" + m.name + "' " +
+                        (exists ? std::string("names a source joint outside the source surface, which is not placed")
+                                : "names no source joint; source joints: " + jf_join(source_joints.names, 60)));
+      }
+      if (!m.position.allFinite() || !inside_t(m.position))
+        return fail(StatusCode::InvalidArgument, "marker '" + m.name + "' lies outside the target surface; click on or inside the mesh");
+      pinned[k] = 1;
+      delta[k] = m.position - out.P.row(k).transpose();
+    }
+    // Hops between joints along the hierarchy (small sets: BFS per pinned joint).
+    std::vector<std::vector<int>> adj(out.size());
+    for (int i = 0; i < out.size(); ++i)
+      if (out.parent[i] >= 0) adj[i].push_back(out.parent[i]), adj[out.parent[i]].push_back(i);
+    Eigen::MatrixXd D = Eigen::MatrixXd::Zero(out.size(), 3);
+    Eigen::VectorXd W = Eigen::VectorXd::Zero(out.size());
+    for (int k = 0; k < out.size(); ++k) {
+      if (!pinned[k]) continue;
+      std::vector<int> hop(out.size(), -1);
+      std::vector<int> q = {k};
+      hop[k] = 0;
+      for (size_t h = 0; h < q.size(); ++h)
+        for (int nb : adj[q[h]])
+          if (hop[nb] < 0 && hop[q[h]] < opt.marker_reach && !pinned[nb]) hop[nb] = hop[q[h]] + 1, q.push_back(nb);
+      for (int i : q) {
+        if (i == k) continue;
+        const double w = 1.0 - double(hop[i]) / (opt.marker_reach + 1);
+        D.row(i) += w * delta[k].transpose();
+        W[i] += w;
+      }
+    }
+    for (int i = 0; i < out.size(); ++i) {
+      if (pinned[i]) {
+        out.P.row(i) += delta[i].transpose();
+        continue;
+      }
+      if (W[i] <= 0) continue;
+      const Eigen::Vector3d p = out.P.row(i).transpose() + D.row(i).transpose() / std::max(1.0, W[i]);
+      if (inside_t(p)) out.P.row(i) = p.transpose();
+    }
+    outside.erase(std::remove_if(outside.begin(), outside.end(), [&](const std::string& n) {
+                    const int k = out.find(n);
+                    return k >= 0 && inside_t(out.P.row(k).transpose());
+                  }),
+                  outside.end());
+  }
+  if (!outside.empty())
+    return fail(StatusCode::InvalidArgument, "joint" + std::string(outside.size() > 1 ? "s " : " ") + jf_join(outside) +
+                                                 " could not be placed inside the target; pin them with markers");
+  if (!out.P.allFinite()) return fail(StatusCode::NumericalError, "fitted joints are not finite");
+  if (!r.skipped.empty())
+    r.warnings.push_back(std::to_string(r.skipped.size()) + " source joints lie outside the source surface and are not placed: " +
+                         jf_join(r.skipped));
+  progress.update("fitting", 1.0);
+  return r;
+}
+
+}  // namespace mm

@@ -1,0 +1,82 @@
+// joint_fitting: places a source character's named joints inside an unrigged target mesh
+// (automatic joints for paper 002's retargeting, Sec. 3), by fitting the source skeleton onto the
+// target's curve skeleton (retarget/curve_skeleton.h).
+//
+// Steps:
+//  1. curve skeletons of both rest shapes (same options, so both sides are cut alike);
+//  2. up direction: the source's is given (glTF +Y); the target's is the signed axis with the
+//     most limb ends (skeleton leaves) near its low end — feet stand on the ground — unless given;
+//  3. facing (unless given, e.g. +z for glTF by its spec): the 4 axis-aligned turns about up are scored by the chamfer distance between the two
+//     solids (normalised: feet at 0, height 1, centred) plus the distance of matched limb ends;
+//  4. limb ends are matched greedily by normalised position of the end and of a point back_length
+//     up its path (≤ leaf_tolerance × height apart), so A- and T-poses pair hands with hands;
+//     a source limb end that carries joints with no match is a topology mismatch, and so is a
+//     different number of limbs on the ground (biped vs quadruped);
+//  5. each source joint is located on the source skeleton (closest point q on the paths between
+//     matched limb ends) and described, for every pair (a, b) of matched ends whose path holds q,
+//     by the segment of that path between consecutive branch points (medians of a, b and another
+//     matched end c) and its fraction along it; the same labelled segment of the target path
+//     a′–b′ at the same fraction gives a target point (proportions along branches). The target
+//     joint is the mean over pairs plus the joint's offset from q, turned into the target's axes
+//     and scaled by the ratio of the local radii;
+//  6. a joint outside the target is pulled toward its skeleton point until inside; markers pin
+//     named joints and drag their chain neighbours (weights fall off over marker_reach joints).
+// Source joints outside the source surface (roots on the floor, IK targets) are not placed.
+//
+// Status: InvalidMesh (from the skeletons: empty, flat, broken mesh), InvalidArgument (a marker
+// names no source joint or lies outside the target; a topology mismatch, with the limb counts and
+// what to pass), Cancelled. Deterministic.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "character/joint_set.h"
+#include "common/progress.h"
+#include "common/status.h"
+#include "retarget/curve_skeleton.h"
+
+namespace mm {
+
+struct JointFitOptions {
+  CurveSkeletonOptions skeleton;  // both shapes' skeletons
+  int source_up = 1;              // source up axis: 0..2 = +x,+y,+z, 3..5 = −x,−y,−z (glTF: 1)
+  int target_up = -1;             // target up axis as source_up; −1 = detect from the limb ends
+  int source_front = 2;           // source facing axis, as source_up (glTF: +z)
+  int target_front = -1;          // target facing axis; −1 = detect (step 3)
+  double leaf_tolerance = 0.6;    // limb ends match when ≤ this × height apart (normalised shapes; mean of
+                                  // the ends' and the back points' distances)
+  double back_length = 0.25;      // back point of a limb end: this × height up its path (pose-robust matching)
+  double ground_band = 0.12;      // limb ends below this × height count as standing on the ground
+  double inside_tolerance = 0.01; // a joint within this × bbox diagonal outside the surface counts as inside
+  int marker_reach = 3;           // markers move unpinned joints up to this many bones away (0 = only pin)
+  bool check_topology = true;     // refuse a mismatch (step 4); false = fit whatever matches
+};
+
+struct JointMarker {
+  std::string name;               // a source joint name
+  Eigen::Vector3d position;       // target coordinates
+};
+
+struct JointFitResult {
+  Status status;                  // check ok() first
+  JointSet joints;                // source names (joints inside the source), target positions, hierarchy
+  std::vector<std::string> skipped;   // source joints not placed (outside the source surface)
+  std::vector<std::string> warnings;
+  CurveSkeleton source_skeleton, target_skeleton;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // target axes → source axes (axis-aligned)
+  int target_up = 1;              // detected or given up axis of the target (as JointFitOptions)
+  std::vector<std::pair<int, int>> limb_ends;  // matched leaves (source node, target node)
+  int source_ground = 0, target_ground = 0;    // limb ends on the ground (step 4)
+};
+
+// Vs/Fs: source rest surface; source_joints: its joints (names, positions, parents).
+// Vt/Ft: target surface (any triangle soup). markers: may be empty.
+JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, const JointSet& source_joints,
+                          const Eigen::MatrixXd& Vt, const Eigen::MatrixXi& Ft,
+                          const std::vector<JointMarker>& markers = {}, const JointFitOptions& opt = {},
+                          const Progress& progress = {});
+
+}  // namespace mm
