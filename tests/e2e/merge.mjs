@@ -203,9 +203,8 @@ export function registerMergeTests(it, { check, shot, nextFrame, waitIdle, canva
     // Cancel: a second merge stopped from the progress overlay leaves the first result.
     await page.click('#mg-run');
     await page.waitForFunction(() => window.__meshmorph.state.busy?.label && !document.getElementById('progress').hidden, null, { timeout: 10000 });
-    await page.waitForTimeout(300);
-    const busyLabel = await page.evaluate(() => window.__meshmorph.state.busy?.label ?? null);
-    check(busyLabel !== null, 'the second merge ended within 300 ms: nothing left to cancel');
+    // At once: on an idle machine the whole merge takes a few hundred ms (the cancel flag holds
+    // the request's id, so a cancel that arrives before the op starts still stops it).
     await page.click('#cancel', { timeout: 10000 });
     await waitIdle(page, 15000);
     const cancelled = await page.evaluate(() => window.__meshmorph.state.error);
