@@ -79,6 +79,7 @@ WeldResult weld_vertices(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, con
   out.to_welded.resize(n);
   double tol = 0;
   if (V.allFinite()) tol = opt.tolerance * bounding_box_diagonal(V);
+  if (!std::isfinite(tol)) tol = 0;  // the diagonal overflowed (coordinates near 1e300): exact duplicates only
 
   // Contract (unchanged from the x-sweep this replaces): vertices a, b are merged, transitively,
   // when |x_a − x_b| ≤ tol and |v_a − v_b|² ≤ tol² as computed in doubles (tol = 0: identical
@@ -121,7 +122,13 @@ WeldResult weld_vertices(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, con
   auto cell_key = [&](int v, Eigen::Array3d* frac) {
     CellTable::Key k;
     for (int a = 0; a < 3; ++a) {
-      const double q = (V(v, a) - origin[a]) / c, f = std::floor(q);
+      const double q = (V(v, a) - origin[a]) / c;
+      if (!(std::abs(q) < 2e9)) {  // the extent overflowed (coordinates near ±1e308): one clamped
+        k[a] = q > 0 ? 2000000000 : q < 0 ? -2000000000 : 0;  // cell per side, candidates are
+        (*frac)[a] = 0.5;                                     // still checked by distance
+        continue;
+      }
+      const double f = std::floor(q);
       k[a] = static_cast<int32_t>(f);
       (*frac)[a] = q - f;
     }
