@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "app/joints_job.h"
 #include "character/prop_tracks.h"
 #include "io/gltf_document.h"
 #include "io/joints_json.h"
@@ -91,13 +92,16 @@ Status RetargetJob::prepare(const io::Asset& source, const io::Asset& target, co
     target_F_ = target.F_raw;
   }
   if (target_joints_json == "auto") {
-    // Automatic joints (issue 14): the source's skeleton fitted inside the target.
-    JointFitOptions fo;
-    if (target_is_gltf_) fo.target_up = 1, fo.target_front = 2;  // glTF: +Y up, front +Z by its spec
-    JointFitResult fit = fit_joints(source_.V_rest, source_.F, character_joints(source_), target_V_, target_F_, {}, fo,
-                                    progress.sub(0, 0.3));
+    // Automatic joints (issue 14): the joints job's fit, read back from its JSON as a joints file
+    // is, so that the CLI, `meshmorph joints` and the page (which sends that JSON) get the same joints.
+    JointsJobOptions jo;
+    jo.surface = opt.surface;
+    const JointsJobResult fit = run_joints_job(source, target, "", jo, progress.sub(0, 0.3));
     if (!fit.status.ok()) return Status{fit.status.code, "automatic target joints: " + fit.status.message};
-    target_joints = std::move(fit.joints);
+    for (const auto& w : fit.warnings) warnings_.push_back("automatic joints: " + w);
+    io::JointSetResult jr = io::parse_joints_json(fit.json);
+    if (!jr.status.ok()) return Status{jr.status.code, "automatic target joints: " + jr.status.message};
+    target_joints = std::move(jr.joints);
   } else if (!target_joints_json.empty()) {
     io::JointSetResult jr = io::parse_joints_json(target_joints_json);
     if (!jr.status.ok()) return Status{jr.status.code, "target joints: " + jr.status.message};

@@ -26,6 +26,8 @@ OUT with .obj/.ply/.off writes one mesh file per frame (OUT_0000.obj, ...).
   --target-joints J.json   {"joint name": [x, y, z], ...} with the source's joint names
                            (needed when TGT has no skin); "auto" fits the source's joints
                            inside TGT (as `meshmorph joints`, default options)
+  --markers M.json         with --target-joints auto: {"joint name": [x, y, z]} pins these
+                           joints of the fit (chin, wrists, elbows, knees, groin, ...)
   --joint-map M.json       {"source joint": "target joint", ...} where names differ
   --frames a:b             shorthand for --first-frame a --last-frame b (either side optional)
 options (app/retarget_job.h):
@@ -70,6 +72,13 @@ int run_retarget(const std::vector<std::string>& argv) {
   else if (args.has("target-joints") && !(s = read_text(args.get("target-joints"), &joints_json)).ok())
     return cli::report("retarget", s);
   if (args.has("joint-map") && !(s = read_text(args.get("joint-map"), &map_json)).ok()) return cli::report("retarget", s);
+  std::string markers_json;
+  if (args.has("markers")) {
+    if (joints_json != "auto")
+      return cli::report("retarget", Status::error(StatusCode::InvalidArgument,
+                                                   "--markers pins the automatic joints: give it with --target-joints auto"));
+    if (!(s = read_text(args.get("markers"), &markers_json)).ok()) return cli::report("retarget", s);
+  }
   if (!(s = cli::check_unused(args)).ok()) return cli::report("retarget", s);
 
   if (!(s = io::check_output_path(out_path)).ok()) return cli::report("retarget", s);
@@ -80,6 +89,13 @@ int run_retarget(const std::vector<std::string>& argv) {
   const Progress progress = cli::terminal_progress();
   app::RetargetJob session;
   const auto t0 = std::chrono::steady_clock::now();
+  if (!markers_json.empty()) {
+    // The pinned fit is the joints job's (as the page does): its JSON is the target's joints.
+    const app::JointsJobResult fit = app::run_joints_job(src.asset, tgt.asset, markers_json, {}, progress.sub(0, 0.1));
+    if (!fit.status.ok()) return cli::report("retarget", Status{fit.status.code, "automatic target joints: " + fit.status.message});
+    for (const auto& w : fit.warnings) std::cerr << "meshmorph retarget: warning: " << w << "\n";
+    joints_json = fit.json;
+  }
   s = session.prepare(src.asset, tgt.asset, joints_json, map_json, opt, progress.sub(0, 0.3));
   if (!s.ok()) return cli::report("retarget", s);
   const auto t1 = std::chrono::steady_clock::now();

@@ -276,7 +276,9 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     await page.waitForFunction(() => window.__meshmorph.state.retarget.target?.id === 'file', null, { timeout: 60000 });
     await waitIdle(page);
     const s0 = await rtState(page);
-    check(s0.jointsFrom === 'file' && s0.joints === 0, `own PLY target: joints ${s0.jointsFrom} ${s0.joints}`);
+    check(s0.jointsFrom === 'auto', `own PLY target: joints from ${s0.jointsFrom} (automatic expected)`);
+    // The person has a joints file: "from a joints file" instead of the automatic fit (cancelled).
+    await page.selectOption('#rt-joints-from', 'file');
     await page.setInputFiles('#rt-joints-file', path.join(repoDir, 'data/joints/human_woman_joints.json'));
     await page.waitForFunction(() => window.__meshmorph.state.retarget.joints === 19, null, { timeout: 30000 });
     // CesiumMan's one clip has no name: it is listed as "(unnamed clip 1)".
@@ -288,6 +290,67 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     await page.evaluate(() => window.__meshmorph.hooks.retargetSeek(1.0));
     await nextFrame(page);
     await shot(page, 'retarget-13-own-files');
+    const joints = await page.evaluate(() => window.__meshmorph.hooks.retargetJoints());
+    check(joints.names.length === 19 && joints.names.includes('Skeleton_torso_joint_1'), `the file's joints were replaced: ${joints.names.slice(0, 3)}`);
+    check(pageErrors.length === 0, `uncaught page errors: ${pageErrors.join(' | ')}`);
+  });
+  it('retarget: automatic joints — the Fox skeleton fitted inside the wolf, a joint dragged to pin it, refitted; both runs equal the CLI\'s (--target-joints auto, --markers)', async ({ page, browser, pageErrors }) => {
+    await openJob(page);
+    await chooseCharacter(page, 'fox');
+    await chooseTarget(page, 'wolf'); // its placed joints (for the Fox skeleton) first
+    await chooseClip(page, 'Walk');
+    await waitRun(page);
+    await page.selectOption('#rt-joints-from', 'auto');
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.fit.status !== 'fitting' && window.__meshmorph.state.retarget.joints > 0, null, { timeout: 120000 });
+    const fitted = await rtState(page);
+    check(fitted.fit.status === 'done' && fitted.joints >= 15, `fit: ${JSON.stringify(fitted.fit)}, ${fitted.joints} joints`);
+    record(browser, 'retarget Fox → wolf: automatic joints fitted (ms)', fitted.fit.ms);
+    const auto = await waitRun(page);
+    await nextFrame(page);
+    await shot(page, 'retarget-14-automatic-joints');
+    const k = 5;
+    const wolfArgs = ['--source', path.join(repoDir, 'data/anim/Fox/glTF-Binary/Fox.glb'), '--clip', 'Walk', '--target', path.join(repoDir, 'data/anim/wolf0.ply'), '--target-joints', 'auto'];
+    const autoFrame = await page.evaluate((i) => window.__meshmorph.hooks.retargetFrame(i), k);
+    const relAuto = compareFrame(autoFrame, cliFrame(wolfArgs, k, 'retarget-cli-fox-wolf-auto'), 'Fox → wolf, automatic joints');
+    record(browser, 'retarget Fox → wolf (automatic joints) frame 5: page vs CLI (max / height)', relAuto.toExponential(2));
+    check(relAuto < 1e-4, `automatic joints: frame ${k} differs from the CLI's by ${relAuto} of the height`);
+
+    // Drag a joint with the real mouse (press on its sphere, move, release): it is pinned there
+    // and the others are fitted again around it; a new run starts.
+    const before = await page.evaluate(() => window.__meshmorph.hooks.retargetJoints());
+    const j = before.names.findIndex((n) => /head/i.test(n)) >= 0 ? before.names.findIndex((n) => /head/i.test(n)) : before.names.length - 1;
+    const at = await page.evaluate((i) => window.__meshmorph.hooks.retargetJointOnScreen(i), j);
+    const runs = auto.runs;
+    const camera = await page.evaluate(() => window.__meshmorph.hooks.retargetCamera());
+    await page.mouse.move(at.x, at.y);
+    await page.mouse.down();
+    for (let step = 1; step <= 5; ++step) await page.mouse.move(at.x, at.y + step, { steps: 1 });
+    await page.mouse.up();
+    await page.waitForFunction((n) => Object.keys(window.__meshmorph.state.retarget.pins).length === 1 && window.__meshmorph.state.retarget.fit.status === 'done' && window.__meshmorph.state.retarget.runs > n, runs, { timeout: 120000 });
+    const pinned = await waitRun(page);
+    const pin = pinned.pins[before.names[j]];
+    check(pin, `no pin for ${before.names[j]}: ${JSON.stringify(pinned.pins)}`);
+    const after = await page.evaluate(() => window.__meshmorph.hooks.retargetJoints());
+    const moved = Math.hypot(...before.positions[j].map((v, c) => v - pin[c]));
+    const heightOfTarget = heightOf(after.positions.flat());
+    check(moved > 0, 'the drag did not move the joint');
+    const kept = Math.hypot(...after.positions[j].map((v, c) => v - pin[c]));
+    check(kept < 0.02 * heightOfTarget, `the pinned joint is ${kept} away from where it was dropped (height ${heightOfTarget})`);
+    const cameraAfter = await page.evaluate(() => window.__meshmorph.hooks.retargetCamera());
+    check(cameraAfter.every((v, c) => v === camera[c]), 'the joint drag orbited the camera');
+    await nextFrame(page);
+    await shot(page, 'retarget-15-pinned-joint');
+    // The pins as the CLI's markers file: the same frame from `--markers`.
+    const pinsFile = await download(page, '#rt-pins-save');
+    const pinsJson = JSON.parse(fs.readFileSync(pinsFile, 'utf8'));
+    check(Object.keys(pinsJson).length === 1, `pins file: ${JSON.stringify(pinsJson)}`);
+    const pinnedFrame = await page.evaluate((i) => window.__meshmorph.hooks.retargetFrame(i), k);
+    const relPinned = compareFrame(pinnedFrame, cliFrame([...wolfArgs, '--markers', pinsFile], k, 'retarget-cli-fox-wolf-pinned'), 'pinned');
+    record(browser, 'retarget Fox → wolf (one pinned joint) frame 5: page vs CLI (max / height)', relPinned.toExponential(2));
+    check(relPinned < 1e-4, `pinned joints: frame ${k} differs from the CLI's by ${relPinned} of the height`);
+    // Clear pins: fitted again without them.
+    await page.click('#rt-pins-clear');
+    await page.waitForFunction(() => Object.keys(window.__meshmorph.state.retarget.pins).length === 0 && window.__meshmorph.state.retarget.fit.status === 'done' && window.__meshmorph.state.retarget.joints > 0, null, { timeout: 120000 });
     check(pageErrors.length === 0, `uncaught page errors: ${pageErrors.join(' | ')}`);
   });
 }

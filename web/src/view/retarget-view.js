@@ -57,7 +57,9 @@ export class RetargetView {
     this.sides.target.root.add(this.jointGroup);
     this.jointMaterial = new THREE.MeshBasicMaterial({ color: 0xffd23f, depthTest: false, transparent: true });
     this.boneMaterial = new THREE.LineBasicMaterial({ color: 0x39e6a0, depthTest: false, transparent: true });
+    this.pinnedMaterial = new THREE.MeshBasicMaterial({ color: 0xff4f6d, depthTest: false, transparent: true });
     this.joints = { spheres: [], lines: null, bones: [], count: 0 };
+    this.dragging = -1; // the joint being dragged
     this.seeThrough = false;
   }
 
@@ -212,6 +214,85 @@ export class RetargetView {
       p.needsUpdate = true;
     }
     this.viewer.requestRender();
+  }
+
+  // Pinned joints (indices) drawn in their own colour.
+  setPinned(indices) {
+    const pinned = new Set(indices);
+    this.joints.spheres.forEach((s, j) => { s.material = pinned.has(j) ? this.pinnedMaterial : this.jointMaterial; });
+    this.viewer.requestRender();
+  }
+
+  // Joint spheres the person can drag with the primary button (the orbit controls do not see
+  // that press). The joint moves in the plane through it facing the camera; onDrop(j, [x, y, z])
+  // in target coordinates when the button goes up. canDrag() says whether dragging is on now.
+  // Returns a function that detaches the listeners.
+  attachJointDrag({ canDrag = () => true, onDrop = () => {} }) {
+    const canvas = this.viewer.renderer.domElement;
+    const parent = canvas.parentElement;
+    let drag = null; // {j, plane, flat, pointerId}
+    const local = (clientX, clientY) => {
+      const { camera, rect } = this.view('target');
+      const ndc = new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
+      const ray = new THREE.Raycaster();
+      ray.setFromCamera(ndc, camera);
+      const hit = ray.ray.intersectPlane(drag.plane, new THREE.Vector3());
+      return hit ? hit.applyMatrix4(this.sides.target.root.matrixWorld.clone().invert()) : null;
+    };
+    const down = (e) => {
+      if (e.button !== 0 || !this.active || !this.jointGroup.visible || !canDrag()) return;
+      const j = this.jointAt(e.clientX, e.clientY);
+      if (j < 0) return;
+      e.stopPropagation();
+      e.preventDefault();
+      const { camera } = this.view('target');
+      const world = this.joints.spheres[j].getWorldPosition(new THREE.Vector3());
+      const normal = camera.getWorldDirection(new THREE.Vector3());
+      const flat = this.joints.spheres.flatMap((s) => s.position.toArray());
+      drag = { j, plane: new THREE.Plane().setFromNormalAndCoplanarPoint(normal, world), flat, pointerId: e.pointerId };
+      this.dragging = j;
+      window.addEventListener('pointermove', move, true);
+      window.addEventListener('pointerup', up, true);
+    };
+    const move = (e) => {
+      if (!drag || e.pointerId !== drag.pointerId) return;
+      e.stopPropagation();
+      const p = local(e.clientX, e.clientY);
+      if (!p) return;
+      drag.flat.splice(3 * drag.j, 3, p.x, p.y, p.z);
+      this.moveJoints(drag.flat);
+    };
+    const up = (e) => {
+      if (!drag || e.pointerId !== drag.pointerId) return;
+      e.stopPropagation();
+      const { j, flat } = drag;
+      drag = null;
+      this.dragging = -1;
+      window.removeEventListener('pointermove', move, true);
+      window.removeEventListener('pointerup', up, true);
+      onDrop(j, flat.slice(3 * j, 3 * j + 3));
+    };
+    parent.addEventListener('pointerdown', down, true);
+    return () => {
+      parent.removeEventListener('pointerdown', down, true);
+      window.removeEventListener('pointermove', move, true);
+      window.removeEventListener('pointerup', up, true);
+    };
+  }
+
+  // The joint whose sphere is under a client pixel (within 10 px of its centre, the nearest), or -1.
+  jointAt(clientX, clientY) {
+    let best = -1;
+    let bestD = 10;
+    this.joints.spheres.forEach((s, j) => {
+      const q = this.toScreen('target', s.position.toArray());
+      const d = Math.hypot(q.x - clientX, q.y - clientY);
+      if (d < bestD) {
+        bestD = d;
+        best = j;
+      }
+    });
+    return best;
   }
 
   clearJoints() {

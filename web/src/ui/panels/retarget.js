@@ -7,9 +7,10 @@
 //   2 the target: a bundled character (rigged KayKit, or a plain mesh with hand-placed joints)
 //     or the person's own mesh (glTF/OBJ/OFF/PLY); its joints come from its skin or from a
 //     joints file (the CLI's {"name": [x, y, z]}); shown as spheres and bones over the
-//     see-through target. The joints choice (`#rt-joints-from`) is a list: an "automatic" entry
-//     (the automatic-joints job, issue 14) is one more <option> and one more case in
-//     targetJoints().
+//     see-through target. The joints choice (`#rt-joints-from`): its skin, a joints file, or
+//     automatic (the source's skeleton fitted inside the target by the joints job, issue 14;
+//     the default for an unrigged mesh without a bundled joints file). A joint dragged with the
+//     mouse is pinned there (the fit keeps it; pins download as the CLI's --markers file).
 //   3 retarget: method (harmonic / the LBS baseline) and the job's options (optionSchema {job:
 //     'retarget'}); any change starts a new run at once and cancels the one going
 //     (lib/retarget-runner.js): retargetPrepare, then frames in growing batches, each playable
@@ -20,14 +21,16 @@
 //   5 export: the animated GLB (retargetExportGlb: one morph target per frame), the joints JSON;
 //     an animated GLB opened here plays on the target side with the same timeline.
 // State it owns (window.__meshmorph.state.retarget): {step, source ({id, name, family, clips,
-// clip, clipName}), target ({id, name, skinned, vertices}), jointsFrom ('skin' | 'file'),
+// clip, clipName}), target ({id, name, skinned, vertices}), jointsFrom ('skin' | 'file' | 'auto'),
+// pins ({joint name: [x, y, z]}: joints dragged by the person; the automatic fit keeps them),
+// fit ({status: 'idle' | 'fitting' | 'done' | 'error', fits, ms, pins, warnings}),
 // joints (count) , method, run ({status: 'idle' | 'preparing' | 'frames' | 'done' | 'error' |
 // 'stopped', session, frames, received, contiguous, clip, warnings, prepareMs, framesMs}),
 // playing, time, frame, speed, firstFrameMs (choosing the clip → its first frame shown),
 // shownFrames, runs, exports, played ({name, duration, morphTargets} of an opened GLB)}.
 // Test hooks (window.__meshmorph.hooks): retargetFrame(k) → frame k's positions (array) or null,
 // retargetShown() → the target positions on screen, retargetJoints() → {names, positions},
-// retargetSeek(t), retargetJointOnScreen(j) → {x, y}.
+// retargetSeek(t), retargetJointOnScreen(j) → {x, y}, retargetCamera() → the camera position.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
 import { clipOption, filterClips, jointsFileFor, familiesOf, librarySources, libraryTargets } from '../../lib/clip-library.js';
@@ -77,6 +80,7 @@ const markup = `
     <select id="rt-joints-from">
       <option value="skin">from its skin</option>
       <option value="file">from a joints file</option>
+      <option value="auto">automatic (fitted inside the mesh)</option>
     </select>
     <label class="button file" id="rt-joints-file-label" title="A joints file {&quot;joint name&quot;: [x, y, z]} in the target's coordinates, named like the source's joints (meshmorph retarget --target-joints)">Joints file…<input type="file" id="rt-joints-file" accept=".json,application/json" /></label>
   </div>
@@ -85,6 +89,11 @@ const markup = `
     <span id="rt-map-info" class="hint"></span>
   </div>
   <p id="rt-target-info" class="hint"></p>
+  <div class="row" id="rt-pins-row" hidden>
+    <span id="rt-pins-info" class="hint"></span>
+    <button id="rt-pins-clear" type="button" title="Forget every pinned joint and fit again">Clear pins</button>
+    <button id="rt-pins-save" type="button" title="The pinned joints as the CLI's markers file (meshmorph retarget --target-joints auto --markers M.json)">Download pins JSON</button>
+  </div>
   <div class="row">
     <label title="Draw the target see-through with its joints (spheres) and bones (lines)"><input type="checkbox" id="rt-skeleton" checked /> Joints and bones</label>
   </div>
@@ -192,6 +201,7 @@ export const panel = {
       step: 0, source: null, target: null, jointsFrom: 'skin', joints: 0, method: 'harmonic',
       run: { status: 'idle' }, playing: false, time: 0, frame: -1, speed: 1, firstFrameMs: null,
       shownFrames: 0, runs: 0, exports: 0, played: null, view: 'side',
+      pins: {}, fit: { status: 'idle', fits: 0 },
     };
     state.retarget = retarget;
 
@@ -251,9 +261,15 @@ export const panel = {
         next = 'Pick a target: a bundled character, or Open… your own mesh.';
       } else if (!joints) {
         step = 1;
-        next = retarget.jointsFrom === 'file'
-          ? `Load a joints file for ${target.name} (names of the ${source.name} skeleton), or pick a bundled target.`
-          : `${target.name} has no skin: choose "from a joints file" and load one.`;
+        if (retarget.jointsFrom === 'auto') {
+          next = retarget.fit.status === 'fitting'
+            ? `Fitting the ${source.name} skeleton inside ${target.name}…`
+            : `The automatic joints failed: choose "from a joints file", or pick a clip of another character.`;
+        } else {
+          next = retarget.jointsFrom === 'file'
+            ? `Load a joints file for ${target.name} (names of the ${source.name} skeleton), choose "automatic", or pick a bundled target.`
+            : `${target.name} has no skin: choose "automatic" or "from a joints file".`;
+        }
       } else if (run.status === 'preparing' || (run.status === 'frames' && !retarget.shownFrames)) {
         step = 2;
         next = 'Computing: the first frames play as soon as they arrive.';
@@ -317,7 +333,10 @@ export const panel = {
       $('rt-source-info').textContent = `${s.label || s.name}: ${s.gltf.animations.length} clip${s.gltf.animations.length === 1 ? '' : 's'}. Pick one.`;
       app.setStatus(`${s.label || s.name}: ${s.gltf.animations.length} clips`);
       // A source of another skeleton: a bundled target's joints file depends on it.
-      if (target && !target.skinned && target.libraryId) chooseJoints();
+      if (target && !target.skinned && (target.libraryId || retarget.jointsFrom === 'auto')) {
+        if (retarget.jointsFrom === 'auto') retarget.pins = {}; // pins name the old skeleton's joints
+        chooseJoints();
+      }
       refresh();
     }
 
@@ -412,7 +431,8 @@ export const panel = {
       stopRun('a new target');
       view.setTargetMesh({ positions: loaded.buffers.positions, indices: loaded.buffers.indices });
       clearRunDisplay();
-      $('rt-joints-from').value = skinned ? 'skin' : 'file';
+      $('rt-joints-from').value = skinned ? 'skin' : (t.libraryId && hasJointsFile(t.libraryId) ? 'file' : 'auto');
+      retarget.pins = {};
       retarget.jointsFrom = $('rt-joints-from').value;
       jointsText = '';
       mapText = '';
@@ -423,10 +443,18 @@ export const panel = {
 
     // The joints for the target, from the choice: its skin, or a file (a bundled target's file
     // for the source's skeleton; otherwise the person's). Then a new run.
-    async function chooseJoints(userFile = null) {
-      joints = null;
-      view.clearJoints();
-      retarget.joints = 0;
+    // keepShown: the joints on screen stay until the new ones are there (a refit after a drag).
+    async function chooseJoints(userFile = null, keepShown = false) {
+      if (retarget.jointsFrom !== 'auto' && fitRequest) {
+        client.cancel(fitRequest.id); // a fit going is no longer wanted
+        fitRequest = null;
+        retarget.fit = { ...retarget.fit, status: 'idle' };
+      }
+      if (!keepShown) {
+        joints = null;
+        view.clearJoints();
+        retarget.joints = 0;
+      }
       if (!target) return refresh();
       try {
         if (retarget.jointsFrom === 'skin') {
@@ -438,6 +466,22 @@ export const panel = {
           const parentOf = parentsOf(target.gltf);
           setJoints(list, bonesOf(list.map((j) => j.name), parentOf), 'skin');
           jointsText = '';
+        } else if (retarget.jointsFrom === 'auto') {
+          if (!source) {
+            $('rt-target-info').textContent = `${target.name}: ${target.load.info.weldedVertices} vertices. Pick a clip: its character's skeleton is what is fitted inside ${target.name}.`;
+            return refresh();
+          }
+          stopRun('new joints');
+          const fitted = await fitJoints();
+          if (!fitted) return refresh(); // superseded, cancelled or failed (the error is shown)
+          const { names, parents, warnings, json } = fitted.info;
+          const p = fitted.buffers.positions;
+          const list = names.map((name, j) => ({ name, position: [p[3 * j], p[3 * j + 1], p[3 * j + 2]] }));
+          const bones = parents.map((q, j) => (q >= 0 ? [j, q] : null)).filter(Boolean);
+          const pinned = Object.keys(retarget.pins).length;
+          setJoints(list, bones, pinned ? `the automatic fit with ${pinned} pinned` : 'the automatic fit');
+          if (warnings.length) $('rt-target-info').textContent += ` ${warnings.join(' ')}`;
+          jointsText = json;
         } else {
           let text = null;
           let name = null;
@@ -497,7 +541,85 @@ export const panel = {
       view.setJointsVisible($('rt-skeleton').checked);
       view.setSeeThrough($('rt-skeleton').checked);
       $('rt-target-info').textContent = `${target.name}: ${target.load.info.weldedVertices} vertices · ${list.length} joints and ${bones.length} bones from ${from === 'skin' ? 'its skin' : from}.`;
+      showPins();
     }
+
+    // ---- automatic joints (issue 14): the source's skeleton fitted inside the target, pins
+    // (dragged joints) hold named joints where the person put them. Latest fit only.
+
+    let fitRequest = null;
+    async function fitJoints() {
+      if (fitRequest) client.cancel(fitRequest.id);
+      const pins = retarget.pins;
+      const markersJson = Object.keys(pins).length ? JSON.stringify(pins) : '';
+      const req = client.run('retargetJoints', { sourceName: source.name, targetName: target.name, markersJson },
+        { source: source.bytes.slice(), target: target.bytes.slice() },
+        { onProgress: (stage, fraction) => runText(`Fitting the ${source.label || source.name} skeleton inside ${target.name}: ${stage}…`, fraction) });
+      fitRequest = req;
+      const startedAt = performance.now();
+      retarget.fit = { ...retarget.fit, status: 'fitting' };
+      runText(`Fitting the ${source.label || source.name} skeleton inside ${target.name}…`, 0);
+      try {
+        const r = await req.promise;
+        if (fitRequest !== req) return null;
+        retarget.fit = { status: 'done', fits: retarget.fit.fits + 1, ms: Math.round(performance.now() - startedAt), pins: Object.keys(pins).length, warnings: r.info.warnings };
+        runText(`Joints fitted in ${(retarget.fit.ms / 1000).toFixed(1)} s.`);
+        return r;
+      } catch (e) {
+        if (fitRequest !== req || e.code === 'Cancelled') return null;
+        retarget.fit = { ...retarget.fit, status: 'error', error: e.message };
+        runText('');
+        app.showError(e);
+        $('rt-target-info').textContent = `${target.name}: the automatic joints failed — drag joints is not possible without them; choose "from a joints file", or pick another clip's character.`;
+        return null;
+      } finally {
+        if (fitRequest === req) fitRequest = null;
+      }
+    }
+
+    function hasJointsFile(libraryId) {
+      const entry = libraryTargets.find((t) => t.id === libraryId);
+      return Boolean(entry && source && jointsFileFor(entry, source.family));
+    }
+
+    function showPins() {
+      const names = Object.keys(retarget.pins);
+      const draggable = joints && retarget.jointsFrom !== 'skin';
+      $('rt-pins-row').hidden = !draggable;
+      $('rt-pins-info').textContent = retarget.jointsFrom === 'auto'
+        ? (names.length ? `Pinned: ${names.join(', ')}. Drag a joint to pin it too.` : 'A joint in the wrong place? Drag it: it stays where you drop it and the others fit around it.')
+        : 'Drag a joint to move it (the joints file changes).';
+      $('rt-pins-clear').disabled = names.length === 0;
+      $('rt-pins-save').disabled = names.length === 0;
+      if (joints) view.setPinned(joints.names.map((n, j) => (n in retarget.pins ? j : -1)).filter((j) => j >= 0));
+    }
+
+    view.attachJointDrag({
+      canDrag: () => Boolean(joints) && retarget.jointsFrom !== 'skin' && retarget.fit.status !== 'fitting',
+      onDrop: (j, position) => {
+        const name = joints.names[j];
+        if (retarget.jointsFrom === 'auto') {
+          retarget.pins = { ...retarget.pins, [name]: position };
+          showPins();
+          chooseJoints(null, true);
+          return;
+        }
+        // Joints from a file: the moved joint is the new file (download it with Download joints JSON).
+        joints.positions[j] = position;
+        jointsText = JSON.stringify(Object.fromEntries(joints.names.map((n, k) => [n, joints.positions[k]])));
+        retarget.pins = { ...retarget.pins, [name]: position };
+        showPins();
+        startRun();
+      },
+    });
+    $('rt-pins-clear').addEventListener('click', () => {
+      retarget.pins = {};
+      if (retarget.jointsFrom === 'auto') chooseJoints();
+      else showPins();
+    });
+    $('rt-pins-save').addEventListener('click', () => {
+      download(new TextEncoder().encode(`${JSON.stringify(retarget.pins, null, 1)}\n`), `${stem(target.name)}_pins.json`, 'application/json');
+    });
 
     $('rt-target').addEventListener('change', async () => {
       const id = $('rt-target').value;
@@ -526,6 +648,7 @@ export const panel = {
     });
     $('rt-joints-from').addEventListener('change', () => {
       retarget.jointsFrom = $('rt-joints-from').value;
+      retarget.pins = {};
       chooseJoints();
     });
     $('rt-joints-file').addEventListener('change', async () => {
@@ -899,6 +1022,8 @@ export const panel = {
     app.hooks.retargetFrame = (k) => (store?.has(k) ? Array.from(store.frames[k]) : null);
     app.hooks.retargetTimes = () => (store ? Array.from(store.times) : null);
     app.hooks.retargetShown = () => Array.from(view.targetPositions() ?? []);
+    app.hooks.retargetJointOnScreen = (j) => (joints ? view.toScreen('target', joints.positions[j]) : null);
+    app.hooks.retargetCamera = () => viewer.camera.position.toArray();
     app.hooks.retargetJoints = () => (joints ? { names: [...joints.names], positions: joints.positions.map((p) => [...p]), bones: joints.bones.map((b) => [...b]) } : null);
     app.hooks.retargetSeek = (t) => { setPlaying(false); clock.seek(t); applyTime(); return retarget.frame; };
     app.hooks.retargetPlot = () => (plot ? Array.from(plot) : null);
