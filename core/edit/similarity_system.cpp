@@ -145,6 +145,7 @@ Status LaplacianEditor::Impl::build_similarity_system(EditBuild& s, const Progre
     };
     add_stencil(p, static_cast<double>(partner_ptr[p + 1] - partner_ptr[p]));
     for (int k = partner_ptr[p]; k < partner_ptr[p + 1]; ++k) add_stencil(partners[k], -1.0);
+    std::sort(touched.begin(), touched.end());  // sorted: the column loop below starts at the diagonal
     for (int j : touched) {
       y_idx.push_back(j);
       for (int k = 0; k < 3; ++k) y_val.push_back(opt.coherence_weight * acc3[3 * j + k]);
@@ -188,7 +189,9 @@ Status LaplacianEditor::Impl::build_similarity_system(EditBuild& s, const Progre
   const Eigen::SparseMatrix<double, Eigen::RowMajor> Erow = E;  // rows of E
   const EditSparse& Ecol = E;                                        // columns of E
   // Columns of N = AᵀA for the unknowns: lower part of N_UU. (The known columns N_UK are not
-  // needed: right-hand sides are residuals of the unsquared system.)
+  // needed: right-hand sides are residuals of the unsquared system.) Only rows j ≥ i are summed:
+  // the Y_a lists and E's rows are sorted, so each starts at the diagonal (binary search); every
+  // kept entry sums the same terms in the same order as the full column would.
   EditSparse NUU(nU, nU);
   NUU.reserve(static_cast<Eigen::Index>(nU) * 40);
   std::vector<double> acc(nL, 0.0);
@@ -206,22 +209,31 @@ Status LaplacianEditor::Impl::build_similarity_system(EditBuild& s, const Progre
     for (int k = rev_ptr[i]; k < rev_ptr[i + 1]; ++k) {
       const int p = rev_center[k], e = rev_entry[k];
       const double s0 = grads.weights(e, 0), s1 = grads.weights(e, 1), s2 = grads.weights(e, 2);
-      for (int y = y_ptr[p]; y < y_ptr[p + 1]; ++y)
-        add(y_idx[y], s0 * y_val[3 * y] + s1 * y_val[3 * y + 1] + s2 * y_val[3 * y + 2]);
+      const int* y_begin = y_idx.data() + y_ptr[p];
+      const int* y_end = y_idx.data() + y_ptr[p + 1];
+      for (const int* y = std::lower_bound(y_begin, y_end, i); y != y_end; ++y) {
+        const size_t q = static_cast<size_t>(y - y_idx.data());
+        add(*y, s0 * y_val[3 * q] + s1 * y_val[3 * q + 1] + s2 * y_val[3 * q + 2]);
+      }
       if (grad_row[p]) {
         const int c = center_index[pair_centers[p]];
         for (int f = grads.offsets[c]; f < grads.offsets[c + 1]; ++f)
-          add(stencil_local[f], wg * (s0 * grads.weights(f, 0) + s1 * grads.weights(f, 1) + s2 * grads.weights(f, 2)));
+          if (stencil_local[f] >= i)
+            add(stencil_local[f], wg * (s0 * grads.weights(f, 0) + s1 * grads.weights(f, 1) + s2 * grads.weights(f, 2)));
       }
     }
-    for (EditSparse::InnerIterator er(Ecol, i); er; ++er)
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator ej(Erow, er.row()); ej; ++ej)
-        add(static_cast<int>(ej.col()), er.value() * ej.value());
+    const int* e_cols = Erow.innerIndexPtr();
+    const double* e_vals = Erow.valuePtr();
+    for (EditSparse::InnerIterator er(Ecol, i); er; ++er) {
+      const int* row_end = e_cols + Erow.outerIndexPtr()[er.row() + 1];
+      for (const int* c = std::lower_bound(e_cols + Erow.outerIndexPtr()[er.row()], row_end, i); c != row_end; ++c)
+        add(*c, er.value() * e_vals[c - e_cols]);
+    }
     if (soft[i] > 0) add(i, soft[i]);
     std::sort(touched.begin(), touched.end());
     NUU.startVec(i);
     for (int j : touched)
-      if (j >= i && j < nU) NUU.insertBack(j, i) = acc[j];
+      if (j < nU) NUU.insertBack(j, i) = acc[j];
   }
   NUU.finalize();
   E1 = std::move(E);
