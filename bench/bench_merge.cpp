@@ -10,38 +10,12 @@
 #include "io/asset.h"
 #include "merge/cut.h"
 #include "merge/mesh_merge.h"
+#include "mesh/midpoint_subdivide.h"
 #include "mesh/topology.h"
 
 namespace mm::bench {
 namespace {
 
-// One 1→4 midpoint subdivision (shared edge midpoints); boundary loops stay loops.
-Mesh merge_bench_subdivide(const Mesh& m) {
-  std::map<std::pair<int, int>, int> mid;
-  std::vector<Eigen::RowVector3d> extra;
-  const int n = m.num_vertices();
-  auto midpoint = [&](int a, int b) {
-    const auto key = std::minmax(a, b);
-    auto it = mid.find(key);
-    if (it != mid.end()) return it->second;
-    extra.push_back(0.5 * (m.V.row(a) + m.V.row(b)));
-    return mid[key] = n + static_cast<int>(extra.size()) - 1;
-  };
-  Mesh out;
-  out.F.resize(4 * m.F.rows(), 3);
-  for (int f = 0; f < m.F.rows(); ++f) {
-    const int a = m.F(f, 0), b = m.F(f, 1), c = m.F(f, 2);
-    const int ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
-    out.F.row(4 * f) << a, ab, ca;
-    out.F.row(4 * f + 1) << ab, b, bc;
-    out.F.row(4 * f + 2) << ca, bc, c;
-    out.F.row(4 * f + 3) << ab, bc, ca;
-  }
-  out.V.resize(n + static_cast<int>(extra.size()), 3);
-  out.V.topRows(n) = m.V;
-  for (size_t k = 0; k < extra.size(); ++k) out.V.row(n + static_cast<Eigen::Index>(k)) = extra[k];
-  return out;
-}
 
 int merge_bench_extreme(const Eigen::MatrixXd& V, const std::vector<int>& loop, int axis, bool largest) {
   int best = loop[0];
@@ -60,7 +34,7 @@ void merge_suite(Context& ctx) {
   if (!body.status.ok()) return;
   for (int level = 0; level < (ctx.quick ? 1 : 2); ++level) {
     Mesh src = head.asset.mesh();
-    for (int k = 0; k < level; ++k) src = merge_bench_subdivide(src);
+    for (int k = 0; k < level; ++k) src = midpoint_subdivide(src);
     MergeInput in;
     in.target_V = body.V;
     in.target_F = body.F;

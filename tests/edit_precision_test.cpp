@@ -92,7 +92,7 @@ PrecisionCase precision_case(const std::string& file, int subdivisions) {
   PrecisionCase c;
   c.name = file + (subdivisions ? " (subdivided)" : "");
   c.mesh = load(file);
-  for (int k = 0; k < subdivisions; ++k) c.mesh = subdivide(c.mesh);
+  for (int k = 0; k < subdivisions; ++k) c.mesh = midpoint_subdivide(c.mesh);
   const Eigen::MatrixXd& V = c.mesh.V;
   const int n = c.mesh.num_vertices();
   const auto adj = vertex_adjacency(c.mesh.F, n);

@@ -15,6 +15,7 @@
 #include "edit/laplacian_editor.h"
 #include "io/asset.h"
 #include "mesh/mesh.h"
+#include "mesh/midpoint_subdivide.h"
 #include "test_support.h"
 
 namespace mm::edit_test {
@@ -48,32 +49,6 @@ struct BarCase {
   HandleTransform transform;
 };
 
-// 1:4 midpoint subdivision (test helper: a finer tessellation of the same shape).
-inline Mesh subdivide(const Mesh& m) {
-  std::map<std::pair<int, int>, int> mid;
-  std::vector<Eigen::RowVector3d> P;
-  for (int i = 0; i < m.V.rows(); ++i) P.push_back(m.V.row(i));
-  auto midpoint = [&](int a, int b) {
-    auto key = std::make_pair(std::min(a, b), std::max(a, b));
-    auto it = mid.find(key);
-    if (it != mid.end()) return it->second;
-    P.push_back(0.5 * (m.V.row(a) + m.V.row(b)));
-    return mid[key] = static_cast<int>(P.size()) - 1;
-  };
-  Mesh out;
-  out.F.resize(4 * m.F.rows(), 3);
-  for (int f = 0; f < m.F.rows(); ++f) {
-    const int a = m.F(f, 0), b = m.F(f, 1), c = m.F(f, 2);
-    const int ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
-    out.F.row(4 * f) << a, ab, ca;
-    out.F.row(4 * f + 1) << ab, b, bc;
-    out.F.row(4 * f + 2) << ca, bc, c;
-    out.F.row(4 * f + 3) << ab, bc, ca;
-  }
-  out.V.resize(P.size(), 3);
-  for (size_t i = 0; i < P.size(); ++i) out.V.row(static_cast<Eigen::Index>(i)) = P[i];
-  return out;
-}
 
 // Closed slender cylinder along x (radius r, length len, `around` × `along` quads split into
 // triangles, alternate rings rotated by half a step, flat caps fanned from their centres). CCW
@@ -114,7 +89,7 @@ BarCase bar_case_of(Mesh mesh, bool bend);
 
 inline BarCase bar_case(bool bend, const std::string& file = "edit/bar.ply", int subdivisions = 0) {
   Mesh m = load(file);
-  for (int k = 0; k < subdivisions; ++k) m = subdivide(m);
+  for (int k = 0; k < subdivisions; ++k) m = midpoint_subdivide(m);
   return bar_case_of(std::move(m), bend);
 }
 

@@ -18,6 +18,7 @@
 #include "io/asset.h"
 #include "io/info_report.h"
 #include "io/landmarks_file.h"
+#include "mesh/midpoint_subdivide.h"
 #include "test_support.h"
 
 namespace mm {
@@ -27,39 +28,13 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// 1-to-4 midpoint subdivision (every edge split once; shared edges share their midpoint).
-Mesh subdivide(const Mesh& m) {
-  std::unordered_map<uint64_t, int> mid;
-  std::vector<Eigen::RowVector3d> extra;
-  const int n = static_cast<int>(m.V.rows());
-  auto midpoint = [&](int a, int b) {
-    const uint64_t key = (uint64_t(std::min(a, b)) << 32) | uint64_t(std::max(a, b));
-    auto [it, added] = mid.try_emplace(key, n + static_cast<int>(extra.size()));
-    if (added) extra.push_back(0.5 * (m.V.row(a) + m.V.row(b)));
-    return it->second;
-  };
-  Mesh s;
-  s.F.resize(4 * m.F.rows(), 3);
-  for (int f = 0; f < m.F.rows(); ++f) {
-    const int a = m.F(f, 0), b = m.F(f, 1), c = m.F(f, 2);
-    const int ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
-    s.F.row(4 * f) << a, ab, ca;
-    s.F.row(4 * f + 1) << ab, b, bc;
-    s.F.row(4 * f + 2) << ca, bc, c;
-    s.F.row(4 * f + 3) << ab, bc, ca;
-  }
-  s.V.resize(n + static_cast<int>(extra.size()), 3);
-  s.V.topRows(n) = m.V;
-  for (size_t i = 0; i < extra.size(); ++i) s.V.row(n + static_cast<int>(i)) = extra[i];
-  return s;
-}
 
 TEST(HugeInputs, MillionVertexMeshIsLoadedReportedAndConverted) {
 #ifdef __EMSCRIPTEN__
   GTEST_SKIP() << "native: the page's memory limits are the page's tests";
 #endif
   Mesh m = test::load_mesh("pose/camel_ref.ply");  // 21887 vertices → 1.4 M after three splits
-  while (m.V.rows() < 1000000) m = subdivide(m);
+  while (m.V.rows() < 1000000) m = midpoint_subdivide(m);
   const std::string ply = test::scratch_path("huge_1m.ply"), glb = test::scratch_path("huge_1m.glb");
   ASSERT_TRUE(io::save_mesh(ply, m.V, m.F).ok());
 

@@ -18,6 +18,7 @@
 #include "io/asset.h"
 #include "io/gltf_animation.h"
 #include "io/joints_json.h"
+#include "mesh/midpoint_subdivide.h"
 #include "metrics/retarget_metrics.h"
 #include "retarget/curve_skeleton.h"
 #include "retarget/joint_fitting.h"
@@ -542,30 +543,9 @@ TEST(CurveSkeleton, TimingAt7kAnd50kVertices) {
   const mm::io::LoadResult arm = mm::io::load_asset(mm::test::data_path("edit/armadillo.ply"));
   ASSERT_TRUE(t.status.ok() && arm.status.ok());
   // ~50k: the armadillo (14.6k) with every triangle split in 4 at its edge midpoints (58k).
-  const Eigen::MatrixXd& V = arm.asset.V_raw;
-  const Eigen::MatrixXi& F = arm.asset.F_raw;
-  std::map<std::pair<int, int>, int> mid;
-  std::vector<Eigen::RowVector3d> V2;
-  for (int i = 0; i < V.rows(); ++i) V2.push_back(V.row(i));
-  auto midpoint = [&](int a, int b) {
-    const auto key = std::minmax(a, b);
-    auto it = mid.find(key);
-    if (it != mid.end()) return it->second;
-    V2.push_back(0.5 * (V.row(a) + V.row(b)));
-    return mid[key] = int(V2.size()) - 1;
-  };
-  std::vector<Eigen::Vector3i> F2;
-  for (int f = 0; f < F.rows(); ++f) {
-    const int a = F(f, 0), b = F(f, 1), c = F(f, 2), ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
-    F2.push_back({a, ab, ca});
-    F2.push_back({ab, b, bc});
-    F2.push_back({ca, bc, c});
-    F2.push_back({ab, bc, ca});
-  }
-  Eigen::MatrixXd Vb(V2.size(), 3);
-  for (size_t i = 0; i < V2.size(); ++i) Vb.row(i) = V2[i];
-  Eigen::MatrixXi Fb(F2.size(), 3);
-  for (size_t i = 0; i < F2.size(); ++i) Fb.row(i) = F2[i].transpose();
+  const mm::Mesh fine = mm::midpoint_subdivide(mm::Mesh{arm.asset.V_raw, arm.asset.F_raw});
+  const Eigen::MatrixXd& Vb = fine.V;
+  const Eigen::MatrixXi& Fb = fine.F;
   for (int pass = 0; pass < 2; ++pass) {
     const Eigen::MatrixXd& X = pass ? Vb : t.asset.V_raw;
     const Eigen::MatrixXi& Y = pass ? Fb : t.asset.F_raw;

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "io/asset.h"
+#include "mesh/midpoint_subdivide.h"
 #include "mesh/topology.h"
 #include "mesh/validate.h"
 #include "mesh/weld.h"
@@ -261,6 +262,32 @@ TEST(TopologyRealMesh, ClosedMeshesAreWatertightWithExpectedGenus) {
     EXPECT_TRUE(r.closed()) << c.file;
     EXPECT_EQ(r.euler_characteristic, c.euler) << c.file;
     EXPECT_TRUE(r.status(manifold_defects()).ok()) << c.file << ": " << r.to_text();
+  }
+}
+
+// The 1→4 subdivision the big-input tests and benches use: #F × 4, #V + #E vertices, the same
+// surface (old vertices unmoved, every new one the midpoint of its edge), clean, and every boundary
+// loop twice as long.
+TEST(MidpointSubdivide, FourTimesTheFacesSameSurfaceLoopsKept) {
+  for (const char* file : {"edit/camelhead.ply", "edit/cylinder_coarse.ply"}) {
+    const io::LoadResult lr = io::load_asset(test::data_path(file));
+    ASSERT_TRUE(lr.status.ok()) << lr.status.message;
+    const Mesh m = lr.asset.mesh();
+    const Mesh s = midpoint_subdivide(m);
+    const size_t edges = edge_uses(m.F).size();
+    EXPECT_EQ(s.F.rows(), 4 * m.F.rows()) << file;
+    EXPECT_EQ(static_cast<size_t>(s.V.rows()), m.V.rows() + edges) << file;
+    EXPECT_EQ(s.V.topRows(m.V.rows()), m.V) << file;
+    // Every new vertex is the midpoint of two old ones it sits between in a face.
+    for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+      const int ab = s.F(4 * f, 1), a = m.F(f, 0), b = m.F(f, 1);
+      EXPECT_LT((s.V.row(ab) - 0.5 * (m.V.row(a) + m.V.row(b))).norm(), 1e-15) << file;
+    }
+    const MeshReport r0 = validate_mesh(m.V, m.F), r1 = validate_mesh(s.V, s.F);
+    EXPECT_TRUE(r1.defects.empty()) << file << "\n" << r1.to_text();
+    ASSERT_EQ(r1.boundary_loops.size(), r0.boundary_loops.size()) << file;
+    for (size_t k = 0; k < r0.boundary_loops.size(); ++k) EXPECT_EQ(r1.boundary_loops[k].size(), 2 * r0.boundary_loops[k].size());
+    EXPECT_EQ(r1.num_components, r0.num_components);
   }
 }
 
