@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include "app/edit_spec.h"
+#include "app/merge_job.h"
 #include "common/status.h"
 #include "io/asset.h"
 #include "io/gltf_animation.h"
@@ -138,7 +139,19 @@ inline Status read_joints(const std::string& text) {
   return j.status.ok() ? m.status : j.status;
 }
 
-// By harness name (gltf glb obj off ply edit_spec landmarks joints): what tests/bad/<name>/ holds.
+// Merge specs (meshmorph merge --spec, the page's Merge panel saves them): parse_merge_spec, and
+// what it accepts must read back unchanged from its own JSON (the page's save, the CLI's read).
+inline Status read_merge_spec(const std::string& text) {
+  const app::MergeSpecResult r = app::parse_merge_spec(text);
+  if (!checked(r.status, "merge spec").ok()) return r.status;
+  const std::string saved = app::merge_spec_json(r.spec);
+  const app::MergeSpecResult again = app::parse_merge_spec(saved);
+  if (!again.status.ok()) violated("merge spec", "its own JSON does not read back: " + again.status.message);
+  if (app::merge_spec_json(again.spec) != saved) violated("merge spec", "the round trip changed the spec");
+  return r.status;
+}
+
+// By harness name (gltf glb obj off ply edit_spec merge_spec landmarks joints): what tests/bad/<name>/ holds.
 inline Status read_input(const std::string& harness, const std::vector<uint8_t>& bytes) {
   const std::string text(bytes.begin(), bytes.end());
   if (harness == "gltf") return read_mesh(io::Format::Gltf, bytes);
@@ -147,6 +160,7 @@ inline Status read_input(const std::string& harness, const std::vector<uint8_t>&
   if (harness == "off") return read_mesh(io::Format::Off, bytes);
   if (harness == "ply") return read_mesh(io::Format::Ply, bytes);
   if (harness == "edit_spec") return read_edit_spec(text);
+  if (harness == "merge_spec") return read_merge_spec(text);
   if (harness == "landmarks") return read_landmarks(text);
   if (harness == "joints") return read_joints(text);
   violated("read_input", "unknown harness " + harness);

@@ -44,7 +44,7 @@ std::vector<std::string> list_dir(const std::string& dir) {
 }
 
 TEST(FuzzRegressions, EveryKeptInputGivesItsError) {
-  const std::vector<std::string> harnesses = {"gltf", "glb", "obj", "off", "ply", "edit_spec", "landmarks", "joints"};
+  const std::vector<std::string> harnesses = {"gltf", "glb", "obj", "off", "ply", "edit_spec", "merge_spec", "landmarks", "joints"};
   size_t checked = 0;
   for (const std::string& h : harnesses) {
     for (const std::string& name : list_dir(test::tests_path("bad/" + h))) {
