@@ -348,6 +348,27 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     const relPinned = compareFrame(pinnedFrame, cliFrame([...wolfArgs, '--markers', pinsFile], k, 'retarget-cli-fox-wolf-pinned'), 'pinned');
     record(browser, 'retarget Fox → wolf (one pinned joint) frame 5: page vs CLI (max / height)', relPinned.toExponential(2));
     check(relPinned < 1e-4, `pinned joints: frame ${k} differs from the CLI's by ${relPinned} of the height`);
+    // A joint dropped far outside the wolf: the core refuses the pin, the page says so, takes
+    // the pin back and shows the joints where they were.
+    const held = await page.evaluate(() => window.__meshmorph.hooks.retargetJoints());
+    const k2 = held.names.findIndex((n) => !(n in pinsJson));
+    const at2 = await page.evaluate((i) => window.__meshmorph.hooks.retargetJointOnScreen(i), k2);
+    const fits = (await rtState(page)).fit.fits;
+    await page.evaluate(() => { window.__meshmorph.state.error = null; });
+    await page.mouse.move(at2.x, at2.y);
+    await page.mouse.down();
+    for (let step = 1; step <= 6; ++step) await page.mouse.move(at2.x + 40 * step, at2.y - 25 * step, { steps: 1 });
+    await page.mouse.up();
+    await page.waitForFunction(() => window.__meshmorph.state.error != null, null, { timeout: 120000 });
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.fit.status === 'done', null, { timeout: 30000 });
+    const refused = await rtState(page);
+    const refusedError = await page.evaluate(() => window.__meshmorph.state.error);
+    check(/outside the target surface/.test(refusedError.message), `error for a pin outside: ${JSON.stringify(refusedError)}`);
+    check(Object.keys(refused.pins).length === 1 && refused.fit.fits === fits, `pins after the refused drop: ${JSON.stringify(refused.pins)}, fits ${refused.fit.fits} vs ${fits}`);
+    const back = await page.evaluate((i) => window.__meshmorph.hooks.retargetJointOnScreen(i), k2);
+    check(Math.hypot(back.x - at2.x, back.y - at2.y) < 1.5, `the refused joint did not go back: ${JSON.stringify(back)} vs ${JSON.stringify(at2)}`);
+    check(/was not pinned/.test(await page.textContent('#rt-target-info')), 'no note on the refused pin');
+    await shot(page, 'retarget-16-pin-refused');
     // Clear pins: fitted again without them.
     await page.click('#rt-pins-clear');
     await page.waitForFunction(() => Object.keys(window.__meshmorph.state.retarget.pins).length === 0 && window.__meshmorph.state.retarget.fit.status === 'done' && window.__meshmorph.state.retarget.joints > 0, null, { timeout: 120000 });

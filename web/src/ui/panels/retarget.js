@@ -570,7 +570,7 @@ export const panel = {
         retarget.fit = { ...retarget.fit, status: 'error', error: e.message };
         runText('');
         app.showError(e);
-        $('rt-target-info').textContent = `${target.name}: the automatic joints failed — drag joints is not possible without them; choose "from a joints file", or pick another clip's character.`;
+        $('rt-target-info').textContent = `${target.name}: the automatic joints failed (${e.message}). Choose "from a joints file", or pick a clip of another character.`;
         return null;
       } finally {
         if (fitRequest === req) fitRequest = null;
@@ -599,9 +599,22 @@ export const panel = {
       onDrop: (j, position) => {
         const name = joints.names[j];
         if (retarget.jointsFrom === 'auto') {
+          const before = retarget.pins;
+          const shown = joints.positions.flat();
           retarget.pins = { ...retarget.pins, [name]: position };
           showPins();
-          chooseJoints(null, true);
+          // A pin the fit refuses (dropped outside the mesh) is taken back: the joints return to
+          // where they were and the core's message says why.
+          chooseJoints(null, true).then(() => {
+            if (retarget.fit.status !== 'error') return;
+            retarget.pins = before;
+            retarget.fit = { ...retarget.fit, status: 'done' };
+            view.moveJoints(shown);
+            showPins();
+            $('rt-target-info').textContent = `${joints.names[j]} was not pinned: ${retarget.fit.error.replace(/\.?$/, '.')} Drop it inside ${target.name}.`;
+            if (retarget.run.status !== 'done') startRun();
+            refresh();
+          });
           return;
         }
         // Joints from a file: the moved joint is the new file (download it with Download joints JSON).
