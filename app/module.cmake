@@ -13,7 +13,7 @@ list(APPEND MM_CORE_SOURCES
   app/batch_state.cpp
   app/batch_worker.cpp
   app/batch_run.cpp)
-list(APPEND MM_TEST_SOURCES tests/app_test.cpp tests/batch_test.cpp)
+list(APPEND MM_TEST_SOURCES tests/app_test.cpp tests/batch_test.cpp tests/retarget_checks_test.cpp)
 # Batch job keys include the program version (a new version re-runs every job).
 set_source_files_properties(app/batch_state.cpp PROPERTIES COMPILE_DEFINITIONS MM_PROGRAM_VERSION="${PROJECT_VERSION}")
 # `meshmorph batch` (native/commands/batch.cpp) is built by native/CMakeLists.txt's

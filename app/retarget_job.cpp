@@ -1,8 +1,10 @@
 #include "app/retarget_job.h"
 
 #include <algorithm>
+#include <limits>
 
 #include "app/joints_job.h"
+#include "metrics/retarget_metrics.h"
 #include "character/prop_tracks.h"
 #include "io/gltf_document.h"
 #include "io/joints_json.h"
@@ -120,6 +122,8 @@ Status RetargetJob::prepare(const io::Asset& source, const io::Asset& target, co
   const JointSet source_joints = character_joints(source_);
   RetargetCharacter S{source_.V_rest, source_.F, source_joints};
   RetargetCharacter T{target_V_, target_F_, target_joints};
+  // Multi-part characters interpenetrate at rest by design: per-frame counts leave those pairs out.
+  rest_intersections_ = intersecting_triangle_pairs(target_V_, target_F_);
   if (opt.method == RetargetMethod::Harmonic) {
     s = harmonic_.precompute(S, T, map, opt.harmonic, target_joints_json == "auto" ? progress.sub(0.3, 1) : progress);
     if (!s.ok()) return s;
@@ -139,12 +143,16 @@ Status RetargetJob::prepare(const io::Asset& source, const io::Asset& target, co
 
 Eigen::MatrixXd RetargetJob::source_frame(int k) const { return pose_at(source_, clip_, times_[k]); }
 
-Status RetargetJob::frame(int k, Eigen::MatrixXd* V) const {
+Status RetargetJob::frame(int k, Eigen::MatrixXd* V) const { return frame(k, V, nullptr); }
+
+Status RetargetJob::frame(int k, Eigen::MatrixXd* V, Eigen::MatrixXd* joints) const {
   if (k < 0 || k >= num_frames()) return Status::error(StatusCode::InvalidArgument, "frame index out of range");
+  if (joints) joints->resize(0, 3);
   if (opt_.method == RetargetMethod::Harmonic) {
     RetargetFrame f = harmonic_.retarget(source_frame(k));
     if (!f.status.ok()) return f.status;
     *V = std::move(f.V);
+    if (joints) *joints = std::move(f.joints);
     return Status::success();
   }
   const Matrix4dList world = node_world_matrices(source_, clip_, times_[k]);
@@ -153,13 +161,21 @@ Status RetargetJob::frame(int k, Eigen::MatrixXd* V) const {
   return Status::success();
 }
 
-Status RetargetJob::frames(int first, int count, std::vector<Eigen::MatrixXd>* out, const Progress& progress) const {
+Status RetargetJob::frames(int first, int count, std::vector<Eigen::MatrixXd>* out, const Progress& progress,
+                           FrameChecks* checks) const {
   out->clear();
+  if (checks) *checks = {};
   for (int k = first; k < first + count && k < num_frames(); ++k) {
     if (!progress.update("frames", count > 0 ? double(k - first) / count : 1.0)) return cancelled_status("frames");
-    Eigen::MatrixXd V;
-    Status s = frame(k, &V);
+    Eigen::MatrixXd V, J;
+    Status s = frame(k, &V, checks ? &J : nullptr);
     if (!s.ok()) return s;
+    if (checks) {
+      checks->bone_length_error.push_back(
+          J.rows() > 0 ? bone_length_error({J}, harmonic_.bones(), harmonic_.rest_bone_lengths()).mean
+                       : std::numeric_limits<double>::quiet_NaN());
+      checks->self_intersections.push_back(self_intersection_count(V, target_F_, rest_intersections_));
+    }
     out->push_back(std::move(V));
   }
   progress.update("frames", 1.0);

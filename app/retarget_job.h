@@ -55,8 +55,16 @@ class RetargetJob {
 
   // Target surface (layout of target_rest) at frame k.
   Status frame(int k, Eigen::MatrixXd* V) const;
-  // Frames [first, first + count), with progress per frame ("frames") and cancel.
-  Status frames(int first, int count, std::vector<Eigen::MatrixXd>* out, const Progress& progress = {}) const;
+  // Frame k with the target joints f_t(J_t) (harmonic; empty for LBS).
+  Status frame(int k, Eigen::MatrixXd* V, Eigen::MatrixXd* joints) const;
+  // Frames [first, first + count), with progress per frame ("frames") and cancel. With `checks`,
+  // also each frame's checks (the page plots them under its timeline).
+  struct FrameChecks {
+    std::vector<double> bone_length_error;  // harmonic: mean_b |ℓ_b(t) − ℓ_b| / ℓ_b of f_t(J_t); LBS: NaN
+    std::vector<int> self_intersections;    // intersecting triangle pairs not already in the rest pose
+  };
+  Status frames(int first, int count, std::vector<Eigen::MatrixXd>* out, const Progress& progress = {},
+                FrameChecks* checks = nullptr) const;
   // The source surface at frame k (for metrics: self-retargeting compares with it).
   Eigen::MatrixXd source_frame(int k) const;
   // Target joints at frame k (harmonic only: f_t(J_t) of the used joints), and bone data.
@@ -84,6 +92,7 @@ class RetargetJob {
   Eigen::MatrixXd target_V_;
   Eigen::MatrixXi target_F_;
   std::vector<std::string> warnings_;
+  std::vector<std::pair<int, int>> rest_intersections_;  // pairs that intersect at rest (not counted per frame)
   HarmonicRetargeter harmonic_;
   // LBS baseline state.
   Similarity align_;

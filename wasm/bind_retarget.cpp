@@ -9,7 +9,9 @@
 //                   Uint32Array, warnings: string[]}
 //     options: any option of the retarget job's schema (app/retarget_job.h; optionSchema("retarget"))
 //   retargetFrames(session, first, count, progress?) → {ok, positions: Float32Array
-//                   (count·#V·3, frame-major)}; progress returning false cancels (Cancelled)
+//                   (count·#V·3, frame-major), boneLengthError: number[] (per frame, mean relative;
+//                   NaN for LBS), selfIntersections: number[] (per frame, triangle pairs beyond the
+//                   rest pose's)}; progress returning false cancels (Cancelled)
 //   retargetExportGlb(session, positions: Float32Array|Float64Array (all frames, frame-major))
 //                   → {ok, bytes: Uint8Array}
 //   retargetDispose(session) → boolean
@@ -88,7 +90,8 @@ emscripten::val retarget_frames(int id, int first, int count, emscripten::val pr
   if (it == retarget_sessions().end())
     return status_object(Status::error(StatusCode::InvalidArgument, "unknown retarget session"));
   std::vector<Eigen::MatrixXd> frames;
-  const Status st = it->second.session->frames(first, count, &frames, js_progress(progress));
+  app::RetargetJob::FrameChecks checks;
+  const Status st = it->second.session->frames(first, count, &frames, js_progress(progress), &checks);
   if (!st.ok()) return status_object(st);
   const int nv = static_cast<int>(it->second.session->target_rest().rows());
   Eigen::MatrixXd all(static_cast<Eigen::Index>(frames.size()) * nv, 3);
@@ -96,6 +99,11 @@ emscripten::val retarget_frames(int id, int first, int count, emscripten::val pr
   emscripten::val out = status_object(st);
   out.set("positions", to_float32_array(all));
   out.set("count", static_cast<int>(frames.size()));
+  emscripten::val bone = emscripten::val::array(), inter = emscripten::val::array();
+  for (double e : checks.bone_length_error) bone.call<void>("push", e);
+  for (int c : checks.self_intersections) inter.call<void>("push", c);
+  out.set("boneLengthError", bone);
+  out.set("selfIntersections", inter);
   return out;
 }
 

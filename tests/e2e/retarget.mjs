@@ -231,6 +231,10 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     check(rel < 1e-4, `frame ${k} differs from the CLI's by ${rel} of the height`);
     const plot = await page.evaluate(() => window.__meshmorph.hooks.retargetPlot());
     check(plot && plot.every(Number.isFinite), 'no bone-length plot');
+    // The core's per-frame checks: self-intersecting triangle pairs (beyond the rest pose's).
+    const crossings = await page.evaluate(() => window.__meshmorph.hooks.retargetIntersections());
+    check(crossings && crossings.length === plot.length && crossings.every((c) => Number.isInteger(c) && c >= 0), `self-intersections per frame: ${crossings?.slice(0, 5)}`);
+    record(browser, 'retarget Knight → woman: self-intersecting pairs, max over frames', Math.max(...crossings));
 
     // An option change while frames are computing: the run going is cancelled, a new one runs
     // with the option (fps 15 → about half the frames).

@@ -7,7 +7,7 @@
 // Events (onEvent(type, detail)), all for the current run only:
 //   'progress' {phase: 'prepare' | 'frames', stage, fraction}  fraction of the phase, 0…1
 //   'prepared' {info, buffers}     retargetPrepare's answer (session, frames, times, target)
-//   'frames'   {first, count, positions}
+//   'frames'   {first, count, positions, boneLengthError, selfIntersections} (per frame, the core's checks)
 //   'done'     {session, frames}
 //   'error'    {error}             a failure (MeshMorphError); the run is over
 //   'stopped'  {}                  stop() ended it
@@ -55,7 +55,10 @@ export class RetargetRunner {
         const r = await this.call(generation, 'retargetFrames', { session: this.session, first, count }, {}, 'frames',
           (f) => (first + f * count) / total);
         if (!current()) return;
-        this.onEvent('frames', { first, count: r.info.count, positions: r.buffers.positions });
+        this.onEvent('frames', {
+          first, count: r.info.count, positions: r.buffers.positions,
+          boneLengthError: r.info.boneLengthError, selfIntersections: r.info.selfIntersections,
+        });
         next += r.info.count;
         batch += 1;
         if (r.info.count === 0) break;

@@ -25,6 +25,31 @@ const markup = `
   </div>
 </div>`;
 
+// One series scaled to its own maximum (NaN = a gap); returns that maximum (1 when all are 0).
+function drawSeries(g, c, values, color) {
+  let max = 0;
+  for (const v of values) if (Number.isFinite(v)) max = Math.max(max, v);
+  if (!(max > 0)) max = 1;
+  const n = values.length;
+  g.strokeStyle = color;
+  g.lineWidth = 1.5;
+  g.beginPath();
+  let pen = false;
+  values.forEach((v, k) => {
+    if (!Number.isFinite(v)) {
+      pen = false;
+      return;
+    }
+    const x = n > 1 ? (k / (n - 1)) * (c.width - 2) + 1 : c.width / 2;
+    const y = c.height - 2 - (v / max) * (c.height - 6);
+    if (pen) g.lineTo(x, y);
+    else g.moveTo(x, y);
+    pen = true;
+  });
+  g.stroke();
+  return max;
+}
+
 export class Timeline {
   // onPlay(playing), onSeek(time), onSpeed(speed)
   constructor({ onPlay = () => {}, onSeek = () => {}, onSpeed = () => {} } = {}) {
@@ -83,8 +108,9 @@ export class Timeline {
     for (const [a, b] of ranges) g.fillRect((a / count) * c.width, 0, Math.max(1, ((b - a) / count) * c.width), c.height);
   }
 
-  // values: per frame (NaN = not computed); label: what it is.
-  setPlot(values, label) {
+  // values: per frame (NaN = not computed), a fraction (drawn as %); label: what it is. second
+  // (optional): another series {values, color, legend(max) → text} on its own scale (e.g. counts).
+  setPlot(values, label, second = null) {
     this.plotRow.hidden = !values;
     if (!values) return;
     this.plotLabel.textContent = label;
@@ -95,30 +121,19 @@ export class Timeline {
     g.clearRect(0, 0, c.width, c.height);
     g.fillStyle = '#1a1f2a';
     g.fillRect(0, 0, c.width, c.height);
-    let max = 0;
-    for (const v of values) if (Number.isFinite(v)) max = Math.max(max, v);
-    if (!(max > 0)) max = 1;
-    const n = values.length;
-    g.strokeStyle = '#ffd23f';
-    g.lineWidth = 1.5;
-    g.beginPath();
-    let pen = false;
-    values.forEach((v, k) => {
-      if (!Number.isFinite(v)) {
-        pen = false;
-        return;
-      }
-      const x = n > 1 ? (k / (n - 1)) * (c.width - 2) + 1 : c.width / 2;
-      const y = c.height - 2 - (v / max) * (c.height - 6);
-      if (pen) g.lineTo(x, y);
-      else g.moveTo(x, y);
-      pen = true;
-    });
-    g.stroke();
-    g.fillStyle = '#8d96a8';
+    const max = drawSeries(g, c, values, '#ffd23f');
     g.font = '10px system-ui, sans-serif';
+    g.fillStyle = '#8d96a8';
     g.fillText(`max ${(100 * max).toFixed(1)} %`, 4, 10);
     this.plotMax = max;
+    this.plotSecondMax = null;
+    if (second) {
+      const m2 = drawSeries(g, c, second.values, second.color);
+      const text = second.legend(m2);
+      g.fillStyle = second.color;
+      g.fillText(text, c.width - g.measureText(text).width - 4, 10);
+      this.plotSecondMax = m2;
+    }
   }
 
   // A cursor on the plot at frame `frame` of `count`, with the value in the label's tooltip.

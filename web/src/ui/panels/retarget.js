@@ -238,6 +238,7 @@ export const panel = {
     let follower = null; // JointFollower on the run's rest surface
     let restLengths = null;
     let plot = null;     // Float64Array per frame: mean bone-length change (NaN = not yet)
+    let crossings = null; // Float64Array per frame: self-intersecting triangle pairs (NaN = not yet)
     let shownBuffer = null;
     let form = null;
     let visible = false;
@@ -735,11 +736,24 @@ export const panel = {
       ul.replaceChildren(...list.map((w) => Object.assign(document.createElement('li'), { textContent: w })));
     }
 
+    // Under the timeline: bone-length error per frame (%) and self-intersecting triangle pairs.
+    function showPlot() {
+      if (!plot) {
+        timeline.setPlot(null);
+        return;
+      }
+      const label = retarget.method === 'harmonic'
+        ? 'bone-length error per frame (the map\'s joints) · self-intersecting triangle pairs beyond the rest pose\'s'
+        : 'bone-length change per frame (joints followed on the surface) · self-intersecting triangle pairs beyond the rest pose\'s';
+      timeline.setPlot(plot, label, { values: crossings, color: '#ff6b8a', legend: (m) => `intersections max ${Math.round(m)}` });
+    }
+
     function clearRunDisplay() {
       store = null;
       surface = null;
       follower = null;
       plot = null;
+      crossings = null;
       retarget.frame = -1;
       retarget.shownFrames = 0;
       timeline.setBuffered([], 0);
@@ -779,12 +793,13 @@ export const panel = {
         restLengths = follower ? boneLengths(follower.at(surface.positions), joints.bones) : null;
         if (follower) view.setJoints(joints.positions, joints.bones);
         plot = follower && joints.bones.length ? new Float64Array(info.frames).fill(NaN) : null;
+        crossings = new Float64Array(info.frames).fill(NaN);
         const times = buffers.times;
         clock.setRange(times[0], times[times.length - 1]);
         clock.seek(times[0]);
         timeline.setRange(times[0], times[times.length - 1]);
         timeline.setBuffered([], info.frames);
-        timeline.setPlot(plot, 'bone-length change per frame (joints followed on the surface)');
+        showPlot();
         retarget.frame = -1;
         retarget.shownFrames = 0;
         updateTimelineVisibility();
@@ -797,12 +812,14 @@ export const panel = {
         store.add(detail.first, detail.count, detail.positions);
         run.received = store.received;
         run.contiguous = store.contiguous();
-        if (plot) {
-          for (let k = detail.first; k < detail.first + detail.count; ++k) {
-            plot[k] = boneLengthChange(follower.at(store.frames[k]), joints.bones, restLengths).mean;
-          }
-          timeline.setPlot(plot, 'bone-length change per frame (joints followed on the surface)');
+        for (let k = detail.first; k < detail.first + detail.count; ++k) {
+          // The core's bone-length error of the map's joints f_t(J_t) (harmonic); for LBS, the
+          // joints followed on the surface.
+          const core = detail.boneLengthError?.[k - detail.first];
+          if (plot) plot[k] = Number.isFinite(core) ? core : boneLengthChange(follower.at(store.frames[k]), joints.bones, restLengths).mean;
+          crossings[k] = detail.selfIntersections?.[k - detail.first] ?? NaN;
         }
+        showPlot();
         timeline.setBuffered(store.ranges(), store.count);
         if (!userPaused && !retarget.playing) setPlaying(true);
         applyTime();
@@ -1040,6 +1057,7 @@ export const panel = {
     app.hooks.retargetJoints = () => (joints ? { names: [...joints.names], positions: joints.positions.map((p) => [...p]), bones: joints.bones.map((b) => [...b]) } : null);
     app.hooks.retargetSeek = (t) => { setPlaying(false); clock.seek(t); applyTime(); return retarget.frame; };
     app.hooks.retargetPlot = () => (plot ? Array.from(plot) : null);
+    app.hooks.retargetIntersections = () => (crossings ? Array.from(crossings) : null);
     app.hooks.retargetPreviewFrames = () => preview.frames;
     app.hooks.retargetScrubRect = () => {
       const r = timeline.scrub.getBoundingClientRect();

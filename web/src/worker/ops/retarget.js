@@ -39,7 +39,10 @@ export const ops = {
     const first = options.first ?? 0;
     const count = options.count ?? s.frames - first;
     const r = unwrap(ctx.module.retargetFrames(options.session, first, count, ctx.progress));
-    return { info: { first, count: r.count }, buffers: { positions: r.positions } };
+    return {
+      info: { first, count: r.count, boneLengthError: r.boneLengthError, selfIntersections: r.selfIntersections },
+      buffers: { positions: r.positions },
+    };
   },
   // buffers: {positions: all frames, frame-major, as returned by retargetFrames}
   retargetExportGlb(ctx, options = {}, buffers = {}) {
