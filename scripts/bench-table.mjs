@@ -8,10 +8,21 @@ const key = (r) => `${r.suite}|${r.mesh}|${r.stage}`;
 const wasmByKey = new Map(wasm.map((r) => [key(r), r]));
 const fmt = (ms) => (ms >= 1000 ? `${(ms / 1000).toFixed(2)} s` : `${ms.toFixed(ms < 10 ? 2 : 1)} ms`);
 
-console.log('| suite | mesh | #V | stage | native | wasm | wasm/native | peer (PEERS.md / paper) | note |');
-console.log('|---|---|---|---|---|---|---|---|---|');
+// The peer's time in ms from its figure ("igl 8 ms", "Spectra+LDLT 1.56 s", "paper 001: 0.062 +
+// 0.328 + 0.032 s" → the sum), or null when the figure has no time.
+export function peerMs(text) {
+  const m = /((?:\d+(?:\.\d+)?\s*\+\s*)*\d+(?:\.\d+)?)\s*(ms|s)\b/.exec(text || '');
+  if (!m) return null;
+  const total = m[1].split('+').reduce((a, x) => a + Number(x), 0);
+  return m[2] === 's' ? total * 1000 : total;
+}
+
+console.log('| suite | mesh | #V | stage | native | wasm | wasm/native | peer (PEERS.md / paper) | native/peer | note |');
+console.log('|---|---|---|---|---|---|---|---|---|---|');
 for (const r of native) {
   const w = wasmByKey.get(key(r));
   const ratio = w && r.ms > 0 ? (w.ms / r.ms).toFixed(2) : '—';
-  console.log(`| ${r.suite} | ${r.mesh} | ${r.vertices} | ${r.stage} | ${fmt(r.ms)} | ${w ? fmt(w.ms) : '—'} | ${ratio} | ${r.peer} | ${r.note} |`);
+  const p = peerMs(r.peer);
+  const vsPeer = p && r.ms > 0 ? (r.ms / p).toFixed(2) : '';
+  console.log(`| ${r.suite} | ${r.mesh} | ${r.vertices} | ${r.stage} | ${fmt(r.ms)} | ${w ? fmt(w.ms) : '—'} | ${ratio} | ${r.peer} | ${vsPeer} | ${r.note} |`);
 }
