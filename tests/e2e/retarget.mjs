@@ -319,18 +319,29 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     record(browser, 'retarget Fox → wolf (automatic joints) frame 5: page vs CLI (max / height)', relAuto.toExponential(2));
     check(relAuto < 1e-4, `automatic joints: frame ${k} differs from the CLI's by ${relAuto} of the height`);
 
-    // Drag a joint with the real mouse (press on its sphere, move, release): it is pinned there
-    // and the others are fitted again around it; a new run starts.
+    // Edit joints: playback pauses, the target shows its rest pose. Drag a joint with the real
+    // mouse (press on its sphere, move, release): it is pinned there and the others are fitted
+    // again around it; a new run starts.
+    await page.click('#rt-edit-joints');
+    const editing = await rtState(page);
+    check(editing.editingJoints && !editing.playing, `edit joints: ${JSON.stringify({ editing: editing.editingJoints, playing: editing.playing })}`);
     const before = await page.evaluate(() => window.__meshmorph.hooks.retargetJoints());
     const j = before.names.findIndex((n) => /head/i.test(n)) >= 0 ? before.names.findIndex((n) => /head/i.test(n)) : before.names.length - 1;
     const at = await page.evaluate((i) => window.__meshmorph.hooks.retargetJointOnScreen(i), j);
     const runs = auto.runs;
+    const under = await page.evaluate(([x, y]) => window.__meshmorph.hooks.retargetJointAt(x, y), [at.x, at.y]);
+    check(under === j, `joint under the pointer: ${under}, expected ${j} at ${JSON.stringify(at)}`);
     const camera = await page.evaluate(() => window.__meshmorph.hooks.retargetCamera());
     await page.mouse.move(at.x, at.y);
     await page.mouse.down();
     for (let step = 1; step <= 5; ++step) await page.mouse.move(at.x, at.y + step, { steps: 1 });
     await page.mouse.up();
-    await page.waitForFunction((n) => Object.keys(window.__meshmorph.state.retarget.pins).length === 1 && window.__meshmorph.state.retarget.fit.status === 'done' && window.__meshmorph.state.retarget.runs > n, runs, { timeout: 120000 });
+    await page.waitForFunction((n) => Object.keys(window.__meshmorph.state.retarget.pins).length === 1 && window.__meshmorph.state.retarget.fit.status === 'done' && window.__meshmorph.state.retarget.runs > n, runs, { timeout: 120000 })
+      .catch(async (e) => {
+        const st = await rtState(page);
+        const err = await page.evaluate(() => window.__meshmorph.state.error);
+        throw new Error(`${e.message}: pins ${JSON.stringify(st.pins)}, fit ${JSON.stringify(st.fit)}, runs ${st.runs} (was ${runs}), error ${JSON.stringify(err)}, info "${await page.textContent('#rt-target-info')}"`);
+      });
     const pinned = await waitRun(page);
     const pin = pinned.pins[before.names[j]];
     check(pin, `no pin for ${before.names[j]}: ${JSON.stringify(pinned.pins)}`);

@@ -370,17 +370,28 @@ export class RetargetView {
     this.frame();
   }
 
-  // Each side scaled to display height 1 (its box's height), its box centred in x and z and
-  // standing on y = 0; side by side the source is left, the target right.
+  // The target's up axis (0..2 = +x, +y, +z; 3..5 = −x, −y, −z, as the joints fit reports it):
+  // the target side is turned so that it stands upright (a Z-up PLY from a dataset). Display only.
+  setTargetUp(axis = 1) {
+    const dir = new THREE.Vector3().setComponent(axis % 3, axis >= 3 ? -1 : 1);
+    this.sides.target.root.quaternion.setFromUnitVectors(dir, new THREE.Vector3(0, 1, 0));
+    this.layout();
+    this.frame();
+    this.viewer.requestRender();
+  }
+
+  // Each side scaled to display height 1 (its box's height, after its turn), its box centred in x
+  // and z and standing on y = 0; side by side the source is left, the target right.
   layout() {
     for (const side of Object.values(this.sides)) {
       if (!side.box) continue;
-      const size = side.box.getSize(new THREE.Vector3());
+      const box = side.box.clone().applyMatrix4(new THREE.Matrix4().makeRotationFromQuaternion(side.root.quaternion));
+      const size = box.getSize(new THREE.Vector3());
       const height = size.y > 0 ? size.y : size.length() || 1;
       const scale = 1 / height;
-      const center = side.box.getCenter(new THREE.Vector3());
+      const center = box.getCenter(new THREE.Vector3());
       side.root.scale.setScalar(scale);
-      side.root.position.set(-center.x * scale, -side.box.min.y * scale, -center.z * scale);
+      side.root.position.set(-center.x * scale, -box.min.y * scale, -center.z * scale);
       if (this.mode === 'side') side.root.position.x += (side.name === 'source' ? -1 : 1) * (0.5 + gap / 2) * Math.max(1, size.x * scale);
     }
     this.group.updateMatrixWorld(true);

@@ -90,6 +90,7 @@ const markup = `
   </div>
   <p id="rt-target-info" class="hint"></p>
   <div class="row" id="rt-pins-row" hidden>
+    <label title="Pause and show the target in its rest pose; drag its joints there"><input type="checkbox" id="rt-edit-joints" /> Edit joints (rest pose)</label>
     <span id="rt-pins-info" class="hint"></span>
     <button id="rt-pins-clear" type="button" title="Forget every pinned joint and fit again">Clear pins</button>
     <button id="rt-pins-save" type="button" title="The pinned joints as the CLI's markers file (meshmorph retarget --target-joints auto --markers M.json)">Download pins JSON</button>
@@ -201,7 +202,7 @@ export const panel = {
       step: 0, source: null, target: null, jointsFrom: 'skin', joints: 0, method: 'harmonic',
       run: { status: 'idle' }, playing: false, time: 0, frame: -1, speed: 1, firstFrameMs: null,
       shownFrames: 0, runs: 0, exports: 0, played: null, view: 'side',
-      pins: {}, fit: { status: 'idle', fits: 0 },
+      pins: {}, fit: { status: 'idle', fits: 0 }, editingJoints: false,
     };
     state.retarget = retarget;
 
@@ -430,6 +431,8 @@ export const panel = {
       target = { ...t, gltf, skinned, load: loaded };
       retarget.target = { id: t.libraryId ?? 'file', name: t.name, skinned, vertices: loaded.info.weldedVertices };
       stopRun('a new target');
+      view.setTargetUp(1);
+      if (retarget.editingJoints) setEditingJoints(false);
       view.setTargetMesh({ positions: loaded.buffers.positions, indices: loaded.buffers.indices });
       clearRunDisplay();
       $('rt-joints-from').value = skinned ? 'skin' : (t.libraryId && hasJointsFile(t.libraryId) ? 'file' : 'auto');
@@ -481,6 +484,7 @@ export const panel = {
           const bones = parents.map((q, j) => (q >= 0 ? [j, q] : null)).filter(Boolean);
           const pinned = Object.keys(retarget.pins).length;
           setJoints(list, bones, pinned ? `the automatic fit with ${pinned} pinned` : 'the automatic fit');
+          view.setTargetUp(fitted.info.targetUp); // the fit found which way is up: stand it upright
           if (warnings.length) $('rt-target-info').textContent += ` ${warnings.join(' ')}`;
           jointsText = json;
         } else {
@@ -587,16 +591,38 @@ export const panel = {
       const names = Object.keys(retarget.pins);
       const draggable = joints && retarget.jointsFrom !== 'skin';
       $('rt-pins-row').hidden = !draggable;
-      $('rt-pins-info').textContent = retarget.jointsFrom === 'auto'
-        ? (names.length ? `Pinned: ${names.join(', ')}. Drag a joint to pin it too.` : 'A joint in the wrong place? Drag it: it stays where you drop it and the others fit around it.')
-        : 'Drag a joint to move it (the joints file changes).';
+      if (!draggable && retarget.editingJoints) setEditingJoints(false);
+      $('rt-pins-info').textContent = !retarget.editingJoints
+        ? 'A joint in the wrong place? Edit joints, then drag it.'
+        : retarget.jointsFrom === 'auto'
+          ? (names.length ? `Pinned: ${names.join(', ')}. Drag a joint to pin it too.` : 'Drag a joint: it stays where you drop it and the others fit around it.')
+          : 'Drag a joint to move it (the joints file changes).';
       $('rt-pins-clear').disabled = names.length === 0;
       $('rt-pins-save').disabled = names.length === 0;
       if (joints) view.setPinned(joints.names.map((n, j) => (n in retarget.pins ? j : -1)).filter((j) => j >= 0));
     }
 
+    // Joints are edited in the rest pose (pins are rest-pose positions): playback pauses and the
+    // target shows its rest surface until editing ends.
+    function showRest() {
+      if (surface) view.setTargetPositions(surface.positions);
+      if (joints) view.moveJoints(joints.positions.flat());
+    }
+    function setEditingJoints(on) {
+      retarget.editingJoints = on;
+      $('rt-edit-joints').checked = on;
+      if (on) {
+        setPlaying(false);
+        showRest();
+      } else {
+        applyTime();
+      }
+      showPins();
+    }
+    $('rt-edit-joints').addEventListener('change', () => setEditingJoints($('rt-edit-joints').checked));
+
     view.attachJointDrag({
-      canDrag: () => Boolean(joints) && retarget.jointsFrom !== 'skin' && retarget.fit.status !== 'fitting',
+      canDrag: () => retarget.editingJoints && Boolean(joints) && retarget.jointsFrom !== 'skin' && retarget.fit.status !== 'fitting',
       onDrop: (j, position) => {
         const name = joints.names[j];
         if (retarget.jointsFrom === 'auto') {
@@ -886,6 +912,10 @@ export const panel = {
         return;
       }
       if (!store || !shownBuffer) return;
+      if (retarget.editingJoints) { // the target stays at rest while its joints are edited
+        timeline.setTime(t);
+        return;
+      }
       const at = store.positionsAt(t, shownBuffer);
       if (!at) return;
       view.setTargetPositions(shownBuffer);
@@ -1052,7 +1082,9 @@ export const panel = {
     app.hooks.retargetFrame = (k) => (store?.has(k) ? Array.from(store.frames[k]) : null);
     app.hooks.retargetTimes = () => (store ? Array.from(store.times) : null);
     app.hooks.retargetShown = () => Array.from(view.targetPositions() ?? []);
-    app.hooks.retargetJointOnScreen = (j) => (joints ? view.toScreen('target', joints.positions[j]) : null);
+    // Where joint j's sphere is drawn now (it follows the frames unless joints are being edited).
+    app.hooks.retargetJointOnScreen = (j) => (view.joints.spheres[j] ? view.toScreen('target', view.joints.spheres[j].position.toArray()) : null);
+    app.hooks.retargetJointAt = (x, y) => view.jointAt(x, y);
     app.hooks.retargetCamera = () => viewer.camera.position.toArray();
     app.hooks.retargetJoints = () => (joints ? { names: [...joints.names], positions: joints.positions.map((p) => [...p]), bones: joints.bones.map((b) => [...b]) } : null);
     app.hooks.retargetSeek = (t) => { setPlaying(false); clock.seek(t); applyTime(); return retarget.frame; };
