@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -242,7 +243,9 @@ TEST(MorphExport, CompactLongFoxClipStaysWithinToleranceAndIsSmall) {
   ASSERT_EQ(pf.frames.size(), clip.frames.size());
   EXPECT_LT(max_distance(pf.frames, clip.frames), 1e-5 * size_of(c.V_rest));
 
-  const tinygltf::Model& m = *mm::io::gltf_model(mm::io::load_asset_from_memory(glb_compact, mm::io::Format::Glb, "c.glb").asset);
+  const mm::io::LoadResult back = mm::io::load_asset_from_memory(glb_compact, mm::io::Format::Glb, "c.glb");
+  ASSERT_TRUE(back.status.ok());
+  const tinygltf::Model& m = *mm::io::gltf_model(back.asset);
   EXPECT_EQ(std::count(m.extensionsRequired.begin(), m.extensionsRequired.end(), "KHR_mesh_quantization"), 1);
   const tinygltf::Primitive& prim = m.meshes[c.parts[0].mesh].primitives[c.parts[0].primitive];
   EXPECT_EQ(m.accessors[prim.targets[0].at("POSITION")].componentType, TINYGLTF_COMPONENT_TYPE_FLOAT);  // the mean
@@ -256,7 +259,9 @@ TEST(MorphExport, CompactLongFoxClipStaysWithinToleranceAndIsSmall) {
             << glb_compact.size() << " vs " << glb_frames.size() << " bytes per frame (" << ratio << "x), " << ms << " ms\n";
   RecordProperty("components", rc.components);
   RecordProperty("size_ratio", std::to_string(ratio));
-  EXPECT_GT(ratio, 8.0);
+  // 163 frames: K = 40 components (SHORT, 8 bytes per vertex, and FLOAT normals for 32 of them)
+  // against 163 FLOAT targets (24 bytes per vertex); the gap grows with the clip (see below).
+  EXPECT_GT(ratio, 4.0);
 }
 
 TEST(MorphExport, TighterToleranceNeedsMoreComponentsAndTheCapIsReported) {
@@ -307,6 +312,37 @@ TEST(MorphExport, AutoIsCompactAboveSixtyFrames) {
   EXPECT_TRUE(r.compact);
 }
 
+// Midpoint subdivision (every triangle split into 4); the new vertices follow any motion linearly.
+struct Subdivision {
+  int n;
+  Eigen::MatrixXi F;
+  std::vector<std::pair<int, int>> edges;  // new vertex n + e is the midpoint of edges[e]
+  Subdivision(Eigen::Index n_in, const Eigen::MatrixXi& F_in) : n(static_cast<int>(n_in)), F(4 * F_in.rows(), 3) {
+    std::map<std::pair<int, int>, int> mid;
+    auto midpoint = [&](int a, int b) {
+      const auto key = std::make_pair(std::min(a, b), std::max(a, b));
+      auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      edges.push_back(key);
+      return mid[key] = n + static_cast<int>(edges.size()) - 1;
+    };
+    for (Eigen::Index f = 0; f < F_in.rows(); ++f) {
+      const int a = F_in(f, 0), b = F_in(f, 1), d = F_in(f, 2);
+      const int ab = midpoint(a, b), bd = midpoint(b, d), da = midpoint(d, a);
+      F.row(4 * f) << a, ab, da;
+      F.row(4 * f + 1) << ab, b, bd;
+      F.row(4 * f + 2) << da, bd, d;
+      F.row(4 * f + 3) << ab, bd, da;
+    }
+  }
+  Eigen::MatrixXd apply(const Eigen::MatrixXd& V) const {
+    Eigen::MatrixXd out(n + static_cast<int>(edges.size()), 3);
+    out.topRows(n) = V;
+    for (size_t e = 0; e < edges.size(); ++e) out.row(n + e) = 0.5 * (V.row(edges[e].first) + V.row(edges[e].second));
+    return out;
+  }
+};
+
 // The issue's figure (35 s at 30 fps of a ~35k-vertex character ≤ 40 MB). No bundled character
 // has 35k vertices, so: 1050 frames of the Fox's clips (sampled at 1050 / total duration fps, so
 // all 1050 poses differ) exported at two mesh sizes — the Fox (1728 vertices) and the Fox with
@@ -322,32 +358,9 @@ TEST(MorphExport, IssueFigureThirtyFiveSecondsOfThirtyFiveThousandVertices) {
   clip.frames.resize(std::min<size_t>(clip.frames.size(), 1050));
   clip.times.resize(clip.frames.size());
   ASSERT_GE(clip.frames.size(), 1000u);
-  // Midpoint subdivision of the surface, applied to every frame.
-  std::map<std::pair<int, int>, int> mid;
-  const int n = static_cast<int>(c.V_rest.rows());
-  Eigen::MatrixXi F2(4 * c.F.rows(), 3);
-  std::vector<std::pair<int, int>> edges;
-  auto midpoint = [&](int a, int b) {
-    const auto key = std::make_pair(std::min(a, b), std::max(a, b));
-    auto it = mid.find(key);
-    if (it != mid.end()) return it->second;
-    edges.push_back(key);
-    return mid[key] = n + static_cast<int>(edges.size()) - 1;
-  };
-  for (Eigen::Index f = 0; f < c.F.rows(); ++f) {
-    const int a = c.F(f, 0), b = c.F(f, 1), d = c.F(f, 2);
-    const int ab = midpoint(a, b), bd = midpoint(b, d), da = midpoint(d, a);
-    F2.row(4 * f) << a, ab, da;
-    F2.row(4 * f + 1) << ab, b, bd;
-    F2.row(4 * f + 2) << da, bd, d;
-    F2.row(4 * f + 3) << ab, bd, da;
-  }
-  auto subdivide = [&](const Eigen::MatrixXd& V) {
-    Eigen::MatrixXd out(n + static_cast<int>(edges.size()), 3);
-    out.topRows(n) = V;
-    for (size_t e = 0; e < edges.size(); ++e) out.row(n + e) = 0.5 * (V.row(edges[e].first) + V.row(edges[e].second));
-    return out;
-  };
+  const Subdivision sub(c.V_rest.rows(), c.F);
+  const Eigen::MatrixXi& F2 = sub.F;
+  auto subdivide = [&](const Eigen::MatrixXd& V) { return sub.apply(V); };
   struct Measure {
     int vertices;
     size_t bytes;
@@ -370,6 +383,19 @@ TEST(MorphExport, IssueFigureThirtyFiveSecondsOfThirtyFiveThousandVertices) {
     return Measure{static_cast<int>(V_rest.rows()), glb.size(), r.components, r.max_error, ms};
   };
   const Measure small = measure(c.V_rest, c.F, clip.frames);
+  {
+    mm::io::Asset target;
+    target.V_raw = c.V_rest;
+    target.F_raw = c.F;
+    mm::io::MorphAnimationOptions o;
+    o.layout = mm::io::MorphExport::Frames;
+    std::vector<uint8_t> glb;
+    ASSERT_TRUE(mm::io::write_morph_animation(target, nullptr, clip.frames, clip.times, &glb, o).ok());
+    const double ratio = double(glb.size()) / double(small.bytes);
+    std::cout << "[ 1050 frames, 1728 vertices ] per-frame export " << glb.size() << " bytes, " << ratio << "x the compact one\n";
+    RecordProperty("size_ratio_1050_frames", std::to_string(ratio));
+    EXPECT_GT(ratio, 20.0);
+  }
   std::vector<Eigen::MatrixXd> frames2;
   for (const Eigen::MatrixXd& X : clip.frames) frames2.push_back(subdivide(X));
   clip.frames.clear();
@@ -386,6 +412,43 @@ TEST(MorphExport, IssueFigureThirtyFiveSecondsOfThirtyFiveThousandVertices) {
   // At the cap (K = 64, 32 with normals), whatever the motion: 8 bytes per SHORT position delta,
   // 12 per FLOAT normal delta, 48 for base and mean.
   EXPECT_LE(35000.0 * (64 * 8 + 32 * 12 + 12 + 48) + 1050.0 * 65 * 4, 40e6);
+}
+
+// Timing of the basis alone at the issue's scale (run by hand: --gtest_also_run_disabled_tests;
+// speed belongs to bench/, and 1050 frames of 27.6k vertices hold 0.7 GB of frames).
+TEST(MorphExport, DISABLED_BasisTimingAt1050FramesAnd35kVertices) {
+  Fox fox;
+  ASSERT_TRUE(fox.character.status.ok());
+  const AnimatedCharacter& c = fox.character.character;
+  double duration = 0;
+  for (const auto& clip : c.clips) duration += mm::frame_times(clip, 1000).back() - mm::frame_times(clip, 1000).front();
+  Clip clip = long_clip(c, 1050 / duration);
+  clip.frames.resize(std::min<size_t>(clip.frames.size(), 1050));
+  // Subdivide until ~35k vertices (the Fox's glTF layout has seams: 1728 → 3456 → 8640 → ...).
+  std::vector<Subdivision> levels;
+  Eigen::MatrixXd V = c.V_rest;
+  Eigen::MatrixXi F = c.F;
+  while (V.rows() < 30000) {
+    levels.emplace_back(V.rows(), F);
+    V = levels.back().apply(V);
+    F = levels.back().F;
+  }
+  std::vector<Eigen::MatrixXd> frames;
+  for (auto& X : clip.frames) {
+    Eigen::MatrixXd Y = X;
+    for (const Subdivision& s : levels) Y = s.apply(Y);
+    frames.push_back(std::move(Y));
+    X.resize(0, 3);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::clock_t c0 = std::clock();
+  const mm::MorphBasis b = mm::morph_basis(frames, V);
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
+  ASSERT_TRUE(b.status.ok());
+  const double H = size_of(V);
+  std::cout << "[ basis of " << frames.size() << " frames x " << V.rows() << " vertices ] " << s << " s wall, " << cpu
+            << " s CPU, K(1e-3) = " << mm::morph_basis_size(b, 1e-3 * H) << "\n";
 }
 
 }  // namespace

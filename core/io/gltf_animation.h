@@ -81,12 +81,14 @@ struct MorphAnimationReport {
 // Frames layout: one morph target per frame, weight 1 at its frame.
 // Compact layout (character/morph_basis.h): target 0 is the mean displacement of the clip (FLOAT,
 // weight 1 in every key; mesh.weights stay 0, so the document's static pose is the target's rest
-// pose, which the props' joints also rest in), targets 1..K the principal components. With
-// quantize, component k is stored as integers q_k = round(u_k / δ_k) (SHORT, |q| ≤ 32767,
-// δ_k = max|u_k| / 32767 in the node's space) and the animation's weight is w_fk·δ_k, so the scale
-// of each component lives in the weights (weights stay small: Blender clamps shape-key values to
-// ±10). K is the smallest with every vertex of every frame within the tolerance, measured on the
-// stored data (quantization included); if SHORT storage breaks the bound, FLOAT is used instead.
+// pose, which the props' joints also rest in), targets 1..K the principal components. Each
+// component's weights w_fk (range [lo_k, lo_k + span_k] over the frames) are stored as
+// t_fk·δ_k with t in [0, 1]: lo_k·u_k joins the mean, and span_k·u_k is stored as integers
+// q_k = round(span_k·u_k / δ_k) (SHORT, |q| ≤ 32767, δ_k = max|span_k·u_k| / 32767 in the node's
+// space; with FLOAT storage δ_k = 1). So the weights stay in [0, 1] (Blender clamps shape-key
+// values to their slider range, [0, 1] unless its importer widens it, which Blender 3.4 does from
+// the first key only). K is the smallest with every vertex of every frame within the tolerance,
+// measured on the stored data (quantization included); if SHORT storage breaks the bound, FLOAT is used instead.
 // NORMAL deltas (opt.normals): per target, the least-squares fit of the frames' normal deltas on the
 // same weights (FLOAT; three.js uses them, Blender recomputes normals from the shape anyway), for the
 // first opt.normal_components components (the leading ones carry most of the motion).

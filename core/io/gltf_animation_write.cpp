@@ -275,33 +275,49 @@ double compact_error(const std::vector<WrittenPart>& written, const std::vector<
   return std::sqrt(worst2);
 }
 
+// How the weights w_fk of the basis are stored: w_fk = lo_k + span_k·t_fk with t_fk in [0, 1]; the
+// constant lo_k·u_k joins the mean, span_k·u_k is stored as q_k·δ_k, and the animation's weight is
+// t_fk·δ_k: never negative and at most δ_k (≤ 1 unless a component moves a vertex by more than
+// 32767 units). Blender needs that: its shape keys clamp values to their slider range, [0, 1] by
+// default, and its glTF importer (3.4) widens that range from the first key's weight only.
+struct StoredWeights {
+  Eigen::VectorXd lo, span;  // K: range of each weight column over the frames
+  Eigen::VectorXd delta;     // K: value of one integer step of the stored component (1 for FLOAT)
+};
+
 // The stored basis with K components (quantized or not) and its weights (#frames by 1 + K:
 // column 0 is the mean's weight 1).
 void compact_data(const std::vector<WrittenPart>& written, const MorphBasis& basis, int K, bool quantize,
-                  std::vector<CompactPart>* data, Eigen::MatrixXf* C, Eigen::VectorXd* scales) {
-  std::vector<Eigen::MatrixXd> U_parts;
-  for (const WrittenPart& w : written) U_parts.push_back(node_components(basis.components, w, K));
-  const Eigen::VectorXd delta = component_scales(U_parts, K, quantize);
-  *scales = delta;
+                  std::vector<CompactPart>* data, Eigen::MatrixXf* C, StoredWeights* sw) {
+  const Eigen::MatrixXd W = basis.weights.leftCols(K);
+  sw->lo = W.colwise().minCoeff().transpose();
+  sw->span = (W.colwise().maxCoeff().transpose() - sw->lo).cwiseMax(1e-300);
+  std::vector<Eigen::MatrixXd> U_parts;  // node-space components, scaled by their span
+  for (const WrittenPart& w : written) U_parts.push_back(node_components(basis.components, w, K) * sw->span.asDiagonal());
+  sw->delta = component_scales(U_parts, K, quantize);
   data->assign(written.size(), {});
   for (size_t i = 0; i < written.size(); ++i) {
     const WrittenPart& w = written[i];
     CompactPart& d = (*data)[i];
-    d.mean = (basis.mean.middleRows(w.part->first, w.part->count) * w.L_inv.transpose()).unaryExpr(&float_rounded);
-    d.Q = U_parts[i] * delta.cwiseInverse().asDiagonal();
+    Eigen::MatrixXd mean = basis.mean.middleRows(w.part->first, w.part->count) * w.L_inv.transpose();
+    const Eigen::VectorXd shift = node_components(basis.components, w, K) * sw->lo;  // Σ lo_k u_k, stacked
+    mean += Eigen::Map<const Eigen::MatrixXd>(shift.data(), 3, w.part->count).transpose();
+    d.mean = mean.unaryExpr(&float_rounded);
+    d.Q = U_parts[i] * sw->delta.cwiseInverse().asDiagonal();
     if (quantize) d.Q = d.Q.array().round().cwiseMax(-32767.0).cwiseMin(32767.0).matrix();
     else d.Q = d.Q.unaryExpr(&float_rounded).eval();
   }
-  C->resize(basis.weights.rows(), K + 1);
+  C->resize(W.rows(), K + 1);
   C->col(0).setOnes();
-  C->rightCols(K) = (basis.weights.leftCols(K) * delta.asDiagonal()).cast<float>();
+  for (int k = 0; k < K; ++k)
+    C->col(k + 1) = ((W.col(k).array() - sw->lo[k]) / sw->span[k] * sw->delta[k]).cwiseMax(0.0).matrix().cast<float>();
 }
 
 // NORMAL deltas of the compact targets: mean over the frames and, per component, the
 // least-squares fit on the weights (weights of different components are orthogonal with zero
 // mean, so n_k = Σ_f w_fk ΔN_f / σ_k²), per unit of stored weight. Frames in blocks of 32.
 void compact_normals(const std::vector<WrittenPart>& written, const MorphBasis& basis, const Eigen::MatrixXf& C,
-                     const Eigen::VectorXd& delta,
+                     const StoredWeights& sw,
                      const std::vector<Eigen::MatrixXd>& frames, const Eigen::MatrixXi& F, const Eigen::VectorXi& group,
                      int groups, int K, std::vector<CompactPart>* data, double* max_angle) {
   const int nframes = static_cast<int>(frames.size());
@@ -341,8 +357,15 @@ void compact_normals(const std::vector<WrittenPart>& written, const MorphBasis& 
           }
       }
       if (pass == 0 && f0 + b >= nframes)
-        for (auto& d : *data)
-          for (int k = 0; k < K; ++k) d.N_Q.col(k) /= basis.sigma[k] * basis.sigma[k] * delta[k];
+        for (size_t i = 0; i < data->size(); ++i) {
+          CompactPart& d = (*data)[i];
+          for (int k = 0; k < K; ++k) {
+            d.N_Q.col(k) /= basis.sigma[k] * basis.sigma[k];  // per unit of w
+            const Eigen::VectorXd n = d.N_Q.col(k);
+            d.N_mean += sw.lo[k] * Eigen::Map<const Eigen::MatrixXd>(n.data(), 3, written[i].part->count).transpose();
+            d.N_Q.col(k) *= sw.span[k] / sw.delta[k];  // per unit of stored weight
+          }
+        }
     }
 }
 
@@ -367,14 +390,14 @@ Status add_compact_morphs(tinygltf::Model* m, const std::vector<SurfacePart>& pa
   const int K_float = morph_basis_size(basis, 0.95 * tol);
   std::vector<CompactPart> data;
   Eigen::MatrixXf C;
-  Eigen::VectorXd delta;
+  StoredWeights sw;
   double error = 0;
   int K = 0;
   bool quantize = opt.quantize;
   for (;;) {
     K = K_float < 0 ? K_max : K_float;
     for (;;) {
-      compact_data(s.written, basis, K, quantize, &data, &C, &delta);
+      compact_data(s.written, basis, K, quantize, &data, &C, &sw);
       error = compact_error(s.written, data, frames, C);
       if (error <= tol || K >= K_max) break;
       K = std::min(K_max, K + std::max(1, K / 8));
@@ -384,7 +407,7 @@ Status add_compact_morphs(tinygltf::Model* m, const std::vector<SurfacePart>& pa
   }
   double normal_angle = 0;
   const int K_N = std::clamp(opt.normal_components, 0, K);
-  if (opt.normals) compact_normals(s.written, basis, C, delta, frames, F, group, groups, K_N, &data, &normal_angle);
+  if (opt.normals) compact_normals(s.written, basis, C, sw, frames, F, group, groups, K_N, &data, &normal_angle);
   for (size_t i = 0; i < s.written.size(); ++i) {
     const WrittenPart& w = s.written[i];
     const CompactPart& d = data[i];
