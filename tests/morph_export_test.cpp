@@ -14,8 +14,10 @@
 
 #include <Eigen/SVD>
 
+#include "app/retarget_job.h"
 #include "character/animated_character.h"
 #include "character/morph_basis.h"
+#include "character/prop_tracks.h"
 #include "io/asset.h"
 #include "io/gltf_accessor.h"
 #include "io/gltf_animation.h"
@@ -310,6 +312,50 @@ TEST(MorphExport, AutoIsCompactAboveSixtyFrames) {
   const Clip longer = long_clip(c, 30);
   ASSERT_TRUE(mm::io::write_morph_animation(fox.asset.asset, &c, longer.frames, longer.times, &glb, {}, {}, &r).ok());
   EXPECT_TRUE(r.compact);
+}
+
+TEST(MorphExport, RetargetJobCompactKeepsPropsAndMultiPartTargets) {
+  // Knight → Barbarian with the LBS baseline (fast), the whole Walking_A clip at 30 fps, through
+  // the job's options as the CLI and the batch set them: the Barbarian's several surface primitives
+  // get the compact morphs, and its props (axes, hat, cape) still follow their joints.
+  const mm::io::LoadResult src = mm::io::load_asset(mm::test::data_path("anim/KayKit/Knight.glb"));
+  const mm::io::LoadResult tgt = mm::io::load_asset(mm::test::data_path("anim/KayKit/Barbarian.glb"));
+  ASSERT_TRUE(src.status.ok() && tgt.status.ok());
+  mm::app::RetargetJobOptions opt;
+  ASSERT_TRUE(mm::app::retarget_options().set(opt, "clip", mm::app::OptionValue::of_text("Walking_A")).ok());
+  ASSERT_TRUE(mm::app::retarget_options().set(opt, "method", mm::app::OptionValue::of_text("lbs")).ok());
+  ASSERT_TRUE(mm::app::retarget_options().set(opt, "export", mm::app::OptionValue::of_text("compact")).ok());
+  ASSERT_TRUE(mm::app::retarget_options().set(opt, "export_tolerance", mm::app::OptionValue::of_text("0.002")).ok());
+  mm::app::RetargetJob job;
+  ASSERT_TRUE(job.prepare(src.asset, tgt.asset, "", "", opt).ok());
+  std::vector<Eigen::MatrixXd> frames;
+  ASSERT_TRUE(job.frames(0, job.num_frames(), &frames).ok());
+  std::vector<double> times = job.times();
+  for (double& t : times) t -= job.times().front();
+  std::vector<uint8_t> glb;
+  mm::io::MorphAnimationReport r;
+  ASSERT_TRUE(job.write_glb(frames, times, &glb, &r).ok());
+  save_scratch("retarget_compact_barbarian.glb", glb);
+  const AnimatedCharacter& barb = *job.target_character();
+  EXPECT_GT(barb.parts.size(), 1u);
+  EXPECT_TRUE(r.compact);
+  EXPECT_FALSE(r.capped);
+  EXPECT_LE(r.max_error, 0.002);
+  const Playback p = play(glb, barb);
+  ASSERT_EQ(p.frames.size(), frames.size());
+  EXPECT_LE(max_distance(p.frames, frames), 0.002 * size_of(barb.V_rest));
+  // The props' joint channels are still there, next to the weights channels.
+  const mm::io::LoadResult back = mm::io::load_asset_from_memory(glb, mm::io::Format::Glb, "b.glb");
+  ASSERT_TRUE(back.status.ok());
+  const tinygltf::Model& m = *mm::io::gltf_model(back.asset);
+  int rotations = 0;
+  for (const auto& ch : m.animations[0].channels) rotations += ch.target_path == "rotation";
+  EXPECT_EQ(static_cast<size_t>(rotations), mm::prop_tracks(barb, frames).size());
+  EXPECT_GT(rotations, 0);
+  EXPECT_EQ(m.materials.size(), mm::io::gltf_model(tgt.asset)->materials.size());
+  std::cout << "[ Knight -> Barbarian (LBS), " << frames.size() << " frames, " << barb.V_rest.rows() << " vertices, "
+            << barb.parts.size() << " parts ] K = " << r.components << ", max error " << r.max_error << ", " << glb.size()
+            << " bytes\n";
 }
 
 // Midpoint subdivision (every triangle split into 4); the new vertices follow any motion linearly.
