@@ -246,6 +246,17 @@ std::shared_ptr<BatchWorker::RetargetContext> BatchWorker::retarget_context(cons
 
 namespace {
 
+// The exported GLB: layout, morph targets, K and the measured error of the compact layout.
+void export_metrics(const io::MorphAnimationReport& r, size_t bytes, Json* m) {
+  (*m)["export_layout"] = r.compact ? "compact" : "frames";
+  (*m)["export_bytes"] = static_cast<double>(bytes);
+  (*m)["export_morph_targets"] = r.targets;
+  if (!r.compact) return;
+  (*m)["export_components"] = r.components;
+  (*m)["export_max_error"] = r.max_error;
+  (*m)["export_tolerance_met"] = !r.capped;
+}
+
 double height(const Eigen::MatrixXd& V) { return V.rows() ? V.col(1).maxCoeff() - V.col(1).minCoeff() : 0.0; }
 
 // Metrics every retarget job reports: frames, flipped faces against the rest pose (worst
@@ -303,8 +314,10 @@ Status BatchWorker::run_retarget(const BatchJob& job, const Progress& progress, 
     o->precompute_ms = ms_since(t0);
     o->warnings = session.warnings();
     if (Status s = session.frames(0, session.num_frames(), &frames, progress.sub(0.3, 0.9)); !s.ok()) return s;
-    if (Status s = session.write_glb(frames, session.times(), &bytes); !s.ok()) return s;
+    io::MorphAnimationReport report;
+    if (Status s = session.write_glb(frames, session.times(), &bytes, &report); !s.ok()) return s;
     if (Status s = io::write_file_atomic(job.output, bytes); !s.ok()) return s;
+    export_metrics(report, bytes.size(), &o->metrics);
     retarget_metrics(job, session, FlipCounter(session.target_rest(), session.target_faces()), session.clip_name(), frames,
                      session.times(), nullptr, &o->metrics);
     return Status::success();
@@ -336,14 +349,14 @@ Status BatchWorker::run_retarget(const BatchJob& job, const Progress& progress, 
     frames.push_back(std::move(f.V));
     joints.push_back(std::move(f.joints));
   }
-  // As RetargetJob::write_glb.
-  io::MorphAnimationOptions mo;
-  mo.animation_name = c.name.empty() ? "retarget" : c.name;
-  std::vector<NodeTrack> tracks;
-  if (ctx->opt.props_follow && session.target_is_gltf()) tracks = prop_tracks(*session.target_character(), frames);
-  if (Status s = io::write_morph_animation(ctx->target.asset, session.target_character(), frames, times, &bytes, mo, tracks);
+  RetargetJobOptions export_opt = opt;  // this job's export settings, the pair's props setting
+  export_opt.props_follow = ctx->opt.props_follow;
+  io::MorphAnimationReport report;
+  if (Status s = write_retarget_glb(ctx->target.asset, session.target_character(), export_opt, c.name, frames, times, &bytes,
+                                    &report);
       !s.ok())
     return s;
+  export_metrics(report, bytes.size(), &o->metrics);
   if (Status s = io::write_file_atomic(job.output, bytes); !s.ok()) return s;
   progress.sub(0.9, 1).update("metrics", 0);
   retarget_metrics(job, session, *ctx->flips, c.name, frames, times, &joints, &o->metrics);

@@ -45,6 +45,15 @@ const OptionSchema<RetargetJobOptions>& retarget_options() {
            "joint whose (scaled) trajectory the target follows (\"\" = the shallowest)");
     s.boolean("props_follow", [](O& o) -> bool& { return o.props_follow; },
               "exported GLB: props under joints (weapons, hats) follow the surface");
+    s.choice<io::MorphExport>("export", [](O& o) -> io::MorphExport& { return o.export_layout; },
+                              {{"auto", io::MorphExport::Auto}, {"frames", io::MorphExport::Frames},
+                               {"compact", io::MorphExport::Compact}},
+                              "exported GLB: one morph target per frame, or a PCA basis + weights (compact; auto: "
+                              "compact above 60 frames)");
+    s.number("export_tolerance", [](O& o) -> double& { return o.export_tolerance; }, 1e-7, 0.1,
+             "compact export: max vertex distance to any frame, × the target's size");
+    s.integer("export_max_components", [](O& o) -> int& { return o.export_max_components; }, 1, 4096,
+              "compact export: at most this many morph components (the tolerance is reported as missed above)");
     return s;
   }();
   return schema;
@@ -182,13 +191,23 @@ Status RetargetJob::frames(int first, int count, std::vector<Eigen::MatrixXd>* o
   return Status::success();
 }
 
-Status RetargetJob::write_glb(const std::vector<Eigen::MatrixXd>& frames, const std::vector<double>& times,
-                                  std::vector<uint8_t>* bytes) const {
+Status write_retarget_glb(const io::Asset& target, const AnimatedCharacter* target_character,
+                          const RetargetJobOptions& opt, const std::string& clip_name,
+                          const std::vector<Eigen::MatrixXd>& frames, const std::vector<double>& times,
+                          std::vector<uint8_t>* bytes, io::MorphAnimationReport* report) {
   io::MorphAnimationOptions mo;
-  mo.animation_name = clip_name_.empty() ? "retarget" : clip_name_;
+  mo.animation_name = clip_name.empty() ? "retarget" : clip_name;
+  mo.layout = opt.export_layout;
+  mo.tolerance = opt.export_tolerance;
+  mo.max_components = opt.export_max_components;
   std::vector<NodeTrack> tracks;
-  if (opt_.props_follow && target_is_gltf_) tracks = prop_tracks(target_, frames);
-  return io::write_morph_animation(target_asset_, target_character(), frames, times, bytes, mo, tracks);
+  if (opt.props_follow && target_character) tracks = prop_tracks(*target_character, frames);
+  return io::write_morph_animation(target, target_character, frames, times, bytes, mo, tracks, report);
+}
+
+Status RetargetJob::write_glb(const std::vector<Eigen::MatrixXd>& frames, const std::vector<double>& times,
+                              std::vector<uint8_t>* bytes, io::MorphAnimationReport* report) const {
+  return write_retarget_glb(target_asset_, target_character(), opt_, clip_name_, frames, times, bytes, report);
 }
 
 }  // namespace mm::app

@@ -35,7 +35,19 @@ struct RetargetJobOptions {
   HarmonicRetargetOptions harmonic; // method options (paper defaults, see harmonic_retarget.h)
   io::SurfaceSelection surface = io::SurfaceSelection::Auto;  // which glTF primitives form each character
   bool props_follow = true;         // exported GLB: joints that carry props follow the surface (prop_tracks)
+  io::MorphExport export_layout = io::MorphExport::Auto;  // exported GLB: one morph target per frame,
+                                    // or compact (PCA basis + weights), or compact above 60 frames
+  double export_tolerance = 1e-3;   // compact export: max vertex distance to any frame, × target size
+  int export_max_components = 64;   // compact export: at most this many components (K)
 };
+
+// The retargeted animation as GLB bytes, as RetargetJob::write_glb and the batch write it:
+// props following their joints (opt.props_follow, glTF targets) and the export layout of `opt`.
+// `report` (optional): the layout chosen, K, the measured error.
+Status write_retarget_glb(const io::Asset& target, const AnimatedCharacter* target_character,
+                          const RetargetJobOptions& opt, const std::string& clip_name,
+                          const std::vector<Eigen::MatrixXd>& frames, const std::vector<double>& times,
+                          std::vector<uint8_t>* bytes, io::MorphAnimationReport* report = nullptr);
 
 // Every option of the retarget job; defaults from RetargetJobOptions / HarmonicRetargetOptions.
 const OptionSchema<RetargetJobOptions>& retarget_options();
@@ -79,7 +91,7 @@ class RetargetJob {
 
   // The animated target as GLB bytes (frames as from frames(), times relative to the first).
   Status write_glb(const std::vector<Eigen::MatrixXd>& frames, const std::vector<double>& times,
-                   std::vector<uint8_t>* bytes) const;
+                   std::vector<uint8_t>* bytes, io::MorphAnimationReport* report = nullptr) const;
 
  private:
   RetargetJobOptions opt_;

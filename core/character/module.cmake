@@ -4,4 +4,5 @@ list(APPEND MM_CORE_SOURCES
   core/character/animated_character.cpp
   core/character/joint_set.cpp
   core/character/skinning.cpp
-  core/character/prop_tracks.cpp)
+  core/character/prop_tracks.cpp
+  core/character/morph_basis.cpp)

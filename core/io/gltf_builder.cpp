@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
+#include <cstdint>
 #include <cstring>
 
 namespace mm::io {
@@ -45,6 +47,34 @@ int gltf_append_float_accessor(tinygltf::Model* model, int buffer, const Eigen::
       }
       a.minValues[c] = lo;
       a.maxValues[c] = hi;
+    }
+  }
+  model->accessors.push_back(a);
+  return static_cast<int>(model->accessors.size()) - 1;
+}
+
+int gltf_append_short_vec3_accessor(tinygltf::Model* model, int buffer, const Eigen::MatrixXd& Q) {
+  assert(Q.cols() == 3 && "VEC3 only");
+  std::vector<int16_t> s(static_cast<size_t>(Q.rows()) * 4, 0);  // x, y, z, padding
+  for (Eigen::Index r = 0; r < Q.rows(); ++r)
+    for (int c = 0; c < 3; ++c) {
+      assert(Q(r, c) == std::round(Q(r, c)) && std::abs(Q(r, c)) <= 32767 && "integers of SHORT range");
+      s[r * 4 + c] = static_cast<int16_t>(Q(r, c));
+    }
+  tinygltf::Accessor a;
+  a.bufferView = gltf_append_view(model, buffer, reinterpret_cast<const uint8_t*>(s.data()), s.size() * sizeof(int16_t),
+                                  TINYGLTF_TARGET_ARRAY_BUFFER);
+  model->bufferViews[a.bufferView].byteStride = 8;
+  a.componentType = TINYGLTF_COMPONENT_TYPE_SHORT;
+  a.normalized = false;
+  a.count = static_cast<size_t>(Q.rows());
+  a.type = TINYGLTF_TYPE_VEC3;
+  if (Q.rows() > 0) {
+    a.minValues.assign(3, 0);
+    a.maxValues.assign(3, 0);
+    for (int c = 0; c < 3; ++c) {
+      a.minValues[c] = Q.col(c).minCoeff();
+      a.maxValues[c] = Q.col(c).maxCoeff();
     }
   }
   model->accessors.push_back(a);

@@ -19,6 +19,11 @@ int gltf_append_view(tinygltf::Model* model, int buffer, const uint8_t* data, si
 // (ARRAY_BUFFER) of `buffer`; with_min_max writes min/max of the float values. Returns its index.
 int gltf_append_float_accessor(tinygltf::Model* model, int buffer, const Eigen::MatrixXd& M, bool with_min_max);
 
+// Appends a SHORT (non-normalized) VEC3 accessor of the rows of Q, which must hold integers in
+// [-32767, 32767], in a new bufferView (ARRAY_BUFFER) with byteStride 8 (vertex attributes are
+// 4-byte aligned); with min/max. For KHR_mesh_quantization (the caller declares the extension).
+int gltf_append_short_vec3_accessor(tinygltf::Model* model, int buffer, const Eigen::MatrixXd& Q);
+
 // Appends an UNSIGNED_INT SCALAR index accessor (ELEMENT_ARRAY_BUFFER) for the rows of F, row by
 // row (triangles: 3 columns; line segments: 2).
 int gltf_append_index_accessor(tinygltf::Model* model, int buffer, const Eigen::MatrixXi& F);

@@ -19,5 +19,5 @@ list(APPEND MM_TEST_SOURCES tests/io_test.cpp tests/io_gltf_test.cpp tests/io_ho
 list(APPEND MM_IO_SOURCES core/io/info_report.cpp)  # owned by the lead: the `info` report shared by CLI and wasm
 # glTF skins/animations (read into core/character types) and the morph-target animation writer.
 list(APPEND MM_IO_SOURCES core/io/gltf_animation.cpp core/io/gltf_animation_write.cpp core/io/joints_json.cpp)
-list(APPEND MM_TEST_SOURCES tests/gltf_animation_test.cpp)
+list(APPEND MM_TEST_SOURCES tests/gltf_animation_test.cpp tests/morph_export_test.cpp)
 list(APPEND MM_IO_SOURCES core/io/landmarks_file.cpp core/io/parts_file.cpp core/io/debug_lines_glb.cpp)

@@ -19,9 +19,12 @@ const char* kRetargetUsage = R"(usage: meshmorph retarget --source SRC.glb --tar
                           [--joint-map M.json] [--frames a:b] [options]
 
 Animates TGT (glTF/GLB with or without a skin, or OBJ/OFF/PLY) with a clip of the skinned,
-animated SRC, without rigging TGT (harmonic maps, paper 002). OUT.glb holds the target with one
-morph target per frame and an animation of their weights (plays in three.js and Blender); an
-OUT with .obj/.ply/.off writes one mesh file per frame (OUT_0000.obj, ...).
+animated SRC, without rigging TGT (harmonic maps, paper 002). OUT.glb holds the target with
+morph targets and an animation of their weights (plays in three.js and Blender): one target per
+frame (--export frames), or the clip's mean and K principal components with K weights per frame
+(--export compact; the default for more than 60 frames: K is the smallest that keeps every vertex
+within --export-tolerance × the target's size). An OUT with .obj/.ply/.off writes one mesh file
+per frame (OUT_0000.obj, ...).
 
   --target-joints J.json   {"joint name": [x, y, z], ...} with the source's joint names
                            (needed when TGT has no skin); "auto" fits the source's joints
@@ -106,11 +109,25 @@ int run_retarget(const std::vector<std::string>& argv) {
   const auto t2 = std::chrono::steady_clock::now();
 
   const std::string ext = out_path.size() > 4 ? out_path.substr(out_path.rfind('.') + 1) : "";
+  std::string export_line;
   if (ext == "glb" || ext == "gltf") {
     std::vector<uint8_t> bytes;
-    s = session.write_glb(frames, session.times(), &bytes);
+    io::MorphAnimationReport report;
+    const auto e0 = std::chrono::steady_clock::now();
+    s = session.write_glb(frames, session.times(), &bytes, &report);
     if (!s.ok()) return cli::report("retarget", s);
+    const double export_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - e0).count();
     if (!(s = io::write_file_atomic(out_path, bytes)).ok()) return cli::report("retarget", s);
+    std::ostringstream line;
+    line << "  export " << (report.compact ? "compact" : "frames") << ": " << report.targets << " morph targets";
+    if (report.compact)
+      line << " (mean + K = " << report.components << " components" << (report.quantized ? ", SHORT" : ", FLOAT")
+           << "), max error " << report.max_error << " of the size (tolerance " << opt.export_tolerance << ")";
+    line << ", " << bytes.size() / 1e6 << " MB, " << static_cast<int>(export_ms) << " ms\n";
+    if (report.capped)
+      line << "  warning: the tolerance is not met with " << report.components
+           << " components (--export-max-components); the file is within " << report.max_error << " of the size\n";
+    export_line = line.str();
   } else {
     const std::string stem = out_path.substr(0, out_path.rfind('.'));
     for (size_t k = 0; k < frames.size(); ++k) {
@@ -132,7 +149,7 @@ int run_retarget(const std::vector<std::string>& argv) {
     std::cout << "  " << H.used_joints().size() << " joints, " << H.bones().size() << " bones; bone-length error mean "
               << be.mean << ", max " << be.max << " (relative)\n";
   }
-  std::cout << "  wrote " << out_path << "\n";
+  std::cout << export_line << "  wrote " << out_path << "\n";
   return 0;
 }
 
