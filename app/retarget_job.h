@@ -13,6 +13,7 @@
 #include "common/progress.h"
 #include "common/status.h"
 #include "io/asset.h"
+#include "io/debug_lines_glb.h"
 #include "app/option_schema.h"
 #include "character/animated_character.h"
 #include "io/gltf_animation.h"
@@ -35,6 +36,9 @@ struct RetargetJobOptions {
   HarmonicRetargetOptions harmonic; // method options (paper defaults, see harmonic_retarget.h)
   io::SurfaceSelection surface = io::SurfaceSelection::Auto;  // which glTF primitives form each character
   bool props_follow = true;         // exported GLB: joints that carry props follow the surface (prop_tracks)
+  int graph_frames = 8;             // context graph (harmonic.context_graph): clip frames, evenly spread over
+                                    // the range, whose pruned graphs join the calibration pose's in the
+                                    // fixed topology (0 = calibration pose only); see harmonic_retarget.h
 };
 
 // Every option of the retarget job; defaults from RetargetJobOptions / HarmonicRetargetOptions.
@@ -68,6 +72,13 @@ class RetargetJob {
   const AnimatedCharacter& source_character() const { return source_; }
   const AnimatedCharacter* target_character() const { return target_is_gltf_ ? &target_ : nullptr; }
   const std::vector<std::string>& warnings() const { return warnings_; }
+
+  // The context graph (harmonic method with harmonic.context_graph on; empty otherwise) as
+  // overlay sets for viewing: source nodes, edges and one point set per body part (source
+  // units), the compatible target nodes and edges, and the target's volume graph (target units).
+  // The worker can return them as arrays or as bytes (debug_graph_glb).
+  std::vector<io::DebugGeometry> context_graph_overlay() const;
+  Status debug_graph_glb(std::vector<uint8_t>* bytes) const;
 
   // The animated target as GLB bytes (frames as from frames(), times relative to the first).
   Status write_glb(const std::vector<Eigen::MatrixXd>& frames, const std::vector<double>& times,
