@@ -86,7 +86,7 @@ NonrigidIcpResult nonrigid_icp(const Eigen::MatrixXd& P, const std::vector<std::
   const double beta0 = opt.landmark_weight * std::sqrt(double(n) / std::max(1, nl));
   Eigen::MatrixXd Y = deformed(X), U(n, 3);
   for (double alpha : opt.stiffness) {
-    const double beta = beta0 * alpha / alpha0;
+    const double beta = beta0 * std::pow(alpha / alpha0, opt.landmark_decay);
     for (int it = 0; it < opt.max_inner_iterations; ++it) {
       // Correspondences: closest target points of the current deformed template.
       std::vector<Eigen::Triplet<double>> td;

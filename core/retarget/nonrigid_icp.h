@@ -31,7 +31,8 @@ struct NonrigidIcpOptions {
   int max_inner_iterations = 5;  // solves per stiffness step at most
   double tolerance = 1e-4;       // stop a step when max |ΔX| < tolerance
   double gamma = 1;              // G = diag(1, 1, 1, γ): weight of the translation part in the stiffness
-  double landmark_weight = 1;    // β at the first step, × sqrt(#P / #landmarks); then ∝ α
+  double landmark_weight = 1;    // β at the first step, × sqrt(#P / #landmarks); then ∝ (α/α₀)^landmark_decay
+  double landmark_decay = 1;     // 0 = landmarks keep their weight
   double max_distance = 0.1;     // correspondences farther than this × target diagonal get w = 0
   double converged_residual = 0.01;  // converged when the mean distance of the deformed template to
                                      // the target is below this × target diagonal ...
