@@ -1,13 +1,14 @@
 #include "app/retarget_job.h"
 
 #include <algorithm>
+#include <array>
 #include <limits>
 
 #include "app/joints_job.h"
-#include "metrics/retarget_metrics.h"
 #include "character/prop_tracks.h"
 #include "io/gltf_document.h"
 #include "io/joints_json.h"
+#include "metrics/retarget_metrics.h"
 #include "retarget/joint_fitting.h"
 
 namespace mm::app {
@@ -43,6 +44,17 @@ const OptionSchema<RetargetJobOptions>& retarget_options() {
               "target surface points with affine descriptors (0 = joints only)");
     s.text("anchor_joint", [](O& o) -> std::string& { return o.harmonic.anchor_joint; },
            "joint whose (scaled) trajectory the target follows (\"\" = the shallowest)");
+    s.choice<bool>("context_graph", [](O& o) -> bool& { return o.harmonic.context_graph; },
+                   {{"on", true}, {"off", false}},
+                   "context graph terms E_spatial and E_volume (Sec. 6, Eq. 11-12)");
+    s.number("w_spatial", [](O& o) -> double& { return o.harmonic.w_spatial; }, 0, kUnbounded,
+             "λ_spatial, context-graph Laplacian weight (Sec. 7.2: 0.8)");
+    s.number("w_volume", [](O& o) -> double& { return o.harmonic.w_volume; }, 0, kUnbounded,
+             "λ_volume, volume-graph Laplacian weight (Sec. 7.2: 1)");
+    s.number("graph_max_edge", [](O& o) -> double& { return o.harmonic.graph.max_edge_length; }, 0, 10,
+             "context graph: edges longer than this × the height are pruned (Sec. 6.1: 0.5)");
+    s.integer("graph_frames", [](O& o) -> int& { return o.graph_frames; }, 0, 10000,
+              "context graph: clip frames whose pruned graphs join the fixed topology (0 = rest pose only)");
     s.boolean("props_follow", [](O& o) -> bool& { return o.props_follow; },
               "exported GLB: props under joints (weapons, hats) follow the surface");
     s.choice<io::MorphExport>("export", [](O& o) -> io::MorphExport& { return o.export_layout; },
@@ -134,6 +146,12 @@ Status RetargetJob::prepare(const io::Asset& source, const io::Asset& target, co
   // Multi-part characters interpenetrate at rest by design: per-frame counts leave those pairs out.
   rest_intersections_ = intersecting_triangle_pairs(target_V_, target_F_);
   if (opt.method == RetargetMethod::Harmonic) {
+    std::vector<Eigen::MatrixXd> gf;
+    if (opt.harmonic.context_graph && opt.graph_frames > 0) {
+      const int nf = num_frames(), k = std::min(opt.graph_frames, nf);
+      for (int i = 0; i < k; ++i) gf.push_back(source_frame(k > 1 ? i * (nf - 1) / (k - 1) : 0));
+    }
+    harmonic_.set_graph_frames(std::move(gf));
     s = harmonic_.precompute(S, T, map, opt.harmonic, target_joints_json == "auto" ? progress.sub(0.3, 1) : progress);
     if (!s.ok()) return s;
     for (auto& w : harmonic_.warnings()) warnings_.push_back(w);
@@ -189,6 +207,63 @@ Status RetargetJob::frames(int first, int count, std::vector<Eigen::MatrixXd>* o
   }
   progress.update("frames", 1.0);
   return Status::success();
+}
+
+std::vector<io::DebugGeometry> RetargetJob::context_graph_overlay() const {
+  std::vector<io::DebugGeometry> sets;
+  if (opt_.method != RetargetMethod::Harmonic || !harmonic_.has_context_graph()) return sets;
+  const ContextGraphInfo& g = harmonic_.context_graph();
+  io::DebugGeometry sn, se, tn, te, vn, ve;
+  sn.name = "source graph nodes";
+  sn.P = g.source_nodes;
+  sn.color = {1, 0.2f, 0.1f, 1};
+  se.name = "source graph edges";
+  se.P = g.source_nodes;
+  se.lines = g.edges;
+  se.color = {1, 0.6f, 0.1f, 1};
+  tn.name = "target graph nodes";
+  tn.P = g.target_nodes;
+  tn.color = {0.1f, 0.4f, 1, 1};
+  te.name = "target graph edges";
+  te.P = g.target_nodes;
+  te.lines = g.edges;
+  te.color = {0.2f, 0.8f, 1, 1};
+  vn.name = "target volume graph nodes";
+  vn.P = g.volume_nodes;
+  vn.color = {0.3f, 0.9f, 0.3f, 1};
+  ve.name = "target volume graph edges";
+  ve.P = g.volume_nodes;
+  ve.lines = g.volume_edges;
+  ve.color = {0.3f, 0.7f, 0.3f, 0.6f};
+  for (auto* d : {&sn, &se, &tn, &te, &vn, &ve})
+    if (d->P.rows() > 0 && (d->lines.size() > 0 || d == &sn || d == &tn || d == &vn)) sets.push_back(*d);
+  // One point set per body part (source nodes), colours cycling through a small palette.
+  const std::array<std::array<float, 4>, 8> palette{{{0.9f, 0.1f, 0.1f, 1}, {0.1f, 0.7f, 0.1f, 1}, {0.1f, 0.2f, 0.9f, 1},
+                                                     {0.9f, 0.8f, 0.1f, 1}, {0.8f, 0.1f, 0.8f, 1}, {0.1f, 0.8f, 0.8f, 1},
+                                                     {0.5f, 0.3f, 0.1f, 1}, {0.5f, 0.5f, 0.5f, 1}}};
+  const int np = g.part.size() > 0 ? g.part.maxCoeff() + 1 : 0;
+  const JointSet sj = character_joints(source_);
+  for (int p = 0; p < np; ++p) {
+    std::vector<int> rows;
+    for (int i = 0; i < g.part.size(); ++i)
+      if (g.part[i] == p) rows.push_back(i);
+    if (rows.empty()) continue;
+    io::DebugGeometry d;
+    const JointPair& jp = harmonic_.used_joints()[p];
+    d.name = "part " + std::to_string(p) + " (" + sj.names[jp.source] + ")";
+    d.P.resize(static_cast<Eigen::Index>(rows.size()), 3);
+    for (size_t r = 0; r < rows.size(); ++r) d.P.row(r) = g.source_nodes.row(rows[r]);
+    d.color = palette[p % palette.size()];
+    sets.push_back(std::move(d));
+  }
+  return sets;
+}
+
+Status RetargetJob::debug_graph_glb(std::vector<uint8_t>* bytes) const {
+  const std::vector<io::DebugGeometry> sets = context_graph_overlay();
+  if (sets.empty())
+    return Status::error(StatusCode::InvalidArgument, "no context graph: use the harmonic method with context_graph on");
+  return io::debug_geometry_glb(sets, bytes);
 }
 
 Status write_retarget_glb(const io::Asset& target, const AnimatedCharacter* target_character,

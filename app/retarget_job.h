@@ -13,6 +13,7 @@
 #include "common/progress.h"
 #include "common/status.h"
 #include "io/asset.h"
+#include "io/debug_lines_glb.h"
 #include "app/option_schema.h"
 #include "character/animated_character.h"
 #include "io/gltf_animation.h"
@@ -39,6 +40,9 @@ struct RetargetJobOptions {
                                     // or compact (PCA basis + weights), or compact above 60 frames
   double export_tolerance = 1e-3;   // compact export: max vertex distance to any frame, × target size
   int export_max_components = 64;   // compact export: at most this many components (K)
+  int graph_frames = 8;             // context graph (harmonic.context_graph): clip frames, evenly spread over
+                                    // the range, whose pruned graphs join the calibration pose's in the
+                                    // fixed topology (0 = calibration pose only); see harmonic_retarget.h
 };
 
 // The retargeted animation as GLB bytes, as RetargetJob::write_glb and the batch write it:
@@ -88,6 +92,13 @@ class RetargetJob {
   const AnimatedCharacter& source_character() const { return source_; }
   const AnimatedCharacter* target_character() const { return target_is_gltf_ ? &target_ : nullptr; }
   const std::vector<std::string>& warnings() const { return warnings_; }
+
+  // The context graph (harmonic method with harmonic.context_graph on; empty otherwise) as
+  // overlay sets for viewing: source nodes, edges and one point set per body part (source
+  // units), the compatible target nodes and edges, and the target's volume graph (target units).
+  // The worker can return them as arrays or as bytes (debug_graph_glb).
+  std::vector<io::DebugGeometry> context_graph_overlay() const;
+  Status debug_graph_glb(std::vector<uint8_t>* bytes) const;
 
   // The animated target as GLB bytes (frames as from frames(), times relative to the first).
   Status write_glb(const std::vector<Eigen::MatrixXd>& frames, const std::vector<double>& times,

@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 
+#include "linalg/polar.h"
 #include "linalg/rigid_fit.h"
 #include "mesh/mesh.h"
 #include "retarget/bone_correspondence.h"
@@ -228,6 +229,14 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
     const double ell = opt.map.singularities.offset;
     synth_.add_term({"smooth", ell * mfs_hessian(C.P.topRows(nh), U), opt.w_smooth / std::max(1, nh), true});
   }
+  graph_on_ = false;
+  graph_ = ContextGraphInfo();
+  term_spatial_ = term_volume_ = -1;
+  if (opt.context_graph) {
+    if (!progress.update("context graph", 0.85)) return cancelled_status("context graph");
+    s = build_context_graph(Xs, source.F, Xt, target.F, bvh_s, bvh_t, opt);
+    if (!s.ok()) return s;
+  }
   s = synth_.factor(opt.ridge);
   if (!s.ok()) return s;
   // Per-frame operators. Everything but the bone directions is linear in the projection
@@ -251,6 +260,18 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
     }
     if (!Ga_.allFinite() || !gp_.allFinite() || !Gb_.allFinite())
       return Status::error(StatusCode::NumericalError, "synthesis operators are not finite");
+  }
+  if (graph_on_) {
+    // E_spatial (Eq. 11): B = (s·L·Pa(frame) + R·(L Va − s L Pa_rest)) / ℓ, linear in Pa(frame)
+    // and in the rotated correction; E_volume (Eq. 12): B = R·δ_rest / ℓ_v.
+    const Eigen::MatrixXd Lsd = Eigen::MatrixXd(Lsp_);
+    const double ls = graph_sp_len_, lv = graph_vol_len_;
+    Gsp_pos_ = synth_.solution_operator(term_spatial_, (graph_scale_ / ls) * Lsd);
+    Gsp_corr_ = synth_.solution_operator(term_spatial_, Eigen::MatrixXd::Identity(Lsd.rows(), Lsd.rows()) / ls);
+    Gvol_ = synth_.solution_operator(term_volume_, Eigen::MatrixXd::Identity(vol_delta_.rows(), vol_delta_.rows()) / lv);
+    DmidVS_ = DmidVS_ * src_map_.coefficient_map();
+    if (!Gsp_pos_.allFinite() || !Gsp_corr_.allFinite() || !Gvol_.allFinite())
+      return Status::error(StatusCode::NumericalError, "context-graph operators are not finite");
   }
   progress.update("synthesis", 1.0);
   ready_ = true;
@@ -298,7 +319,26 @@ RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) cons
   }
   // Eq. 18 with the bone term re-linearised around the current target joints (keep each bone's
   // direction, restore its length); only the joints are needed until the last solve.
-  const Eigen::MatrixXd Jt_fixed = KtGa_ * Ys + Ktgp_ * p_anchor;  // joints without the bone term
+  Eigen::MatrixXd Jt_fixed = KtGa_ * Ys + Ktgp_ * p_anchor;  // joints without the bone term
+  // Context graph (Eq. 11, 12): per frame only right-hand sides. Each bone's rotation is the polar
+  // factor of the source map's Jacobian at the source bone's midpoint (Eq. 14 at that point).
+  Eigen::MatrixXd W_graph;
+  if (graph_on_) {
+    std::vector<Eigen::Matrix3d> Rb(nb);
+    for (int b = 0; b < nb; ++b) {
+      const Eigen::Matrix3d JT = DmidVS_.middleRows(3 * b, 3) * Ys;
+      Rb[b] = polar_decomposition(JT.transpose()).R;
+    }
+    auto rotated = [&](const Eigen::MatrixXd& D, const Eigen::VectorXi& bone) {
+      Eigen::MatrixXd C(D.rows(), 3);
+      for (Eigen::Index i = 0; i < D.rows(); ++i)
+        C.row(i) = bone[i] >= 0 ? Eigen::RowVector3d(D.row(i) * Rb[bone[i]].transpose()) : Eigen::RowVector3d(D.row(i));
+      return C;
+    };
+    const Eigen::MatrixXd Pa = src_nodes_.positions(Xs, src_F_);
+    W_graph = Gsp_pos_ * Pa + Gsp_corr_ * rotated(sp_corr_, sp_bone_) + Gvol_ * rotated(vol_delta_, vol_bone_);
+    Jt_fixed += Kt_joints_ * W_graph;
+  }
   Eigen::MatrixXd Jt_now = nb > 0 ? Eigen::MatrixXd(Jt_fixed + KtGb_ * dirs) : Jt_fixed;
   const int relinearisations = nb > 0 ? std::max(0, opt_.bone_iterations) : 0;
   for (int it = 0; it < relinearisations; ++it) {
@@ -310,6 +350,7 @@ RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) cons
   }
   Eigen::MatrixXd Wt = Ga_ * Ys + gp_ * p_anchor;
   if (nb > 0) Wt.noalias() += Gb_ * dirs;
+  if (graph_on_) Wt += W_graph;
   if (!Wt.allFinite()) {
     out.status = Status::error(StatusCode::NumericalError, "synthesized coefficients are not finite");
     return out;
@@ -320,6 +361,10 @@ RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) cons
   out.V.rowwise() += ct_;
   out.joints = (Jt_now * R_) * Lt_;
   out.joints.rowwise() += ct_;
+  if (graph_on_) {
+    out.graph_nodes = ((KtVa_ * Wt) * R_) * Lt_;
+    out.graph_nodes.rowwise() += ct_;
+  }
   out.source_joints = Js_now * Ls_;
   out.source_joints.rowwise() += cs_;
   if (!out.V.allFinite()) {

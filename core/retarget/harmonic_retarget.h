@@ -40,15 +40,19 @@
 #pragma once
 
 #include <map>
+#include <utility>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 #include "common/progress.h"
 #include "common/status.h"
+#include "retarget/context_graph.h"
 #include "retarget/harmonic_map.h"
 #include "retarget/harmonic_synthesis.h"
+#include "retarget/nonrigid_icp.h"
 #include "character/joint_set.h"
 
 namespace mm {
@@ -79,6 +83,36 @@ struct HarmonicRetargetOptions {
   int up_axis = 1;              // source up axis (0 x, 1 y, 2 z) for anchor heights; glTF is +Y
   bool align_axes = true;       // rotate the target into the source's axes (snapped Kabsch on joints)
   double joint_tolerance = 0.01;// joints within this × bbox diagonal outside the surface count as inside
+
+  // Context graph (paper Sec. 6, Eq. 11–12; see "Context graph" above precompute()).
+  bool context_graph = false;   // add E_spatial and E_volume (docs/retarget.md: measured, off by default)
+  ContextGraphOptions graph;    // body parts and pruning rules (Sec. 6.1)
+  double w_spatial = 0.8;       // λ_spatial (Sec. 7.2 list: 0.8)
+  double w_volume = 1.0;        // λ_volume (Sec. 7.2 list: 1)
+  int icp_points = 800;         // non-rigid ICP template: the graph nodes plus FPS source vertices up to this
+  int icp_neighbours = 6;       // k of the template's k-nearest-neighbour stiffness graph
+  NonrigidIcpOptions icp;       // Amberg et al. 2007 schedule and convergence criteria
+  int volume_surface_points = 300;  // target surface nodes of the volume graph (FPS collocation prefix)
+  int volume_bone_samples = 3;      // interior nodes per bone besides its ends
+  int volume_neighbours = 3;        // interior nodes each surface node connects to (visible ones)
+};
+
+// The Context Graph as built by precompute (working frames mapped back to each side's units).
+struct ContextGraphInfo {
+  Eigen::MatrixXd source_nodes;         // #N by 3 nodes on the source calibration surface
+  Eigen::MatrixXd target_nodes;         // #N by 3 compatible nodes on the target calibration surface
+  Eigen::VectorXi target_face;          // #N target triangle of each target node
+  Eigen::MatrixXd target_barycentric;   // #N by 3 its weights (evaluate the nodes on any target frame)
+  std::vector<std::pair<int, int>> edges;  // fixed topology (union over calibration + graph frames)
+  std::vector<std::pair<int, int>> calibration_edges;  // pruned graph of the calibration pose alone
+  Eigen::VectorXi part;                 // #N body part of each node (index into used joints)
+  Eigen::VectorXi vertex_part;          // #V_source body part of each source vertex
+  PruneCounts counts;                   // rule counts at the calibration pose
+  bool icp_converged = false;           // false: target nodes from the fallback (see warnings)
+  double icp_residual = 0;              // mean ICP template-to-target distance / target diagonal
+  Eigen::MatrixXd volume_nodes;         // #Nv by 3 volume graph nodes (target units): surface then interior
+  std::vector<std::pair<int, int>> volume_edges;
+  int volume_surface = 0;               // the first volume_surface rows of volume_nodes are on the surface
 };
 
 struct RetargetFrame {
@@ -87,6 +121,7 @@ struct RetargetFrame {
   Eigen::MatrixXd joints;     // #used joints by 3 target joint positions f_t(J_t)
   Eigen::MatrixXd source_joints;  // #used joints by 3 source joints mapped by the fit f_s(J_s)
   double fit_residual = 0;    // RMS collocation residual of the source fit / source bbox diagonal
+  Eigen::MatrixXd graph_nodes;  // #N by 3 target context-graph nodes f_t(Va) (empty without the graph)
 };
 
 class HarmonicRetargeter {
@@ -96,6 +131,13 @@ class HarmonicRetargeter {
   Status precompute(const RetargetCharacter& source, const RetargetCharacter& target,
                     const std::map<std::string, std::string>& source_to_target = {},
                     const HarmonicRetargetOptions& opt = {}, const Progress& progress = {});
+
+  // Context graph topology (Sec. 6): the paper rebuilds the pruned graph on every deformed source
+  // pose, which would change E_spatial's matrix and the factored normal matrix per frame. Here the
+  // topology is fixed at precompute — the union of the pruned graphs of the calibration pose and
+  // of these source frames (same layout as source.V; e.g. samples of the clip) — and only the node
+  // positions change per frame. Call before precompute; empty = the calibration pose only.
+  void set_graph_frames(std::vector<Eigen::MatrixXd> frames) { graph_frames_ = std::move(frames); }
 
   // Target pose for one source frame V_source (same layout as source.V).
   RetargetFrame retarget(const Eigen::MatrixXd& V_source) const;
@@ -116,8 +158,16 @@ class HarmonicRetargeter {
   const MfsHarmonicMap& source_map() const { return src_map_; }
   const MfsHarmonicMap& target_map() const { return tgt_map_; }
   const std::vector<std::string>& warnings() const { return warnings_; }
+  bool has_context_graph() const { return graph_on_; }
+  const ContextGraphInfo& context_graph() const { return graph_; }
+  // Source graph nodes on a source frame (same layout as source.V), source units.
+  Eigen::MatrixXd source_graph_nodes(const Eigen::MatrixXd& V_source) const;
 
  private:
+  Status build_context_graph(const Eigen::MatrixXd& Xs, const Eigen::MatrixXi& Fs, const Eigen::MatrixXd& Xt,
+                             const Eigen::MatrixXi& Ft, const TriangleBvh& bvh_s, const TriangleBvh& bvh_t,
+                             const HarmonicRetargetOptions& opt);
+
   bool ready_ = false;
   HarmonicRetargetOptions opt_;
   std::vector<std::string> warnings_;
@@ -144,6 +194,25 @@ class HarmonicRetargeter {
   Eigen::VectorXd rest_len_world_;
   HarmonicSynthesis synth_;
   int term_affine_ = -1, term_position_ = -1, term_bone_ = -1;
+  // Context graph (Sec. 6).
+  std::vector<Eigen::MatrixXd> graph_frames_;
+  bool graph_on_ = false;
+  ContextGraphInfo graph_;
+  SurfaceNodes src_nodes_;              // on the source calibration surface (working frame)
+  Eigen::MatrixXi src_F_;
+  int term_spatial_ = -1, term_volume_ = -1;
+  Eigen::SparseMatrix<double> Lsp_;     // rows of the graph Laplacian with degree > 0 (#rows by #N)
+  Eigen::MatrixXd Va_;                  // target nodes (working)
+  Eigen::MatrixXd sp_corr_;             // #rows by 3: L Va − s L Pa_rest (rotated per frame)
+  Eigen::VectorXi sp_bone_;             // #rows bone whose rotation turns sp_corr_ (-1: none)
+  Eigen::MatrixXd Gsp_pos_, Gsp_corr_;  // N_a by #N, N_a by #rows
+  Eigen::MatrixXd vol_delta_;           // #rows_v by 3 rest Laplacian coordinates of the volume graph
+  Eigen::VectorXi vol_bone_;            // #rows_v
+  Eigen::MatrixXd Gvol_;                // N_a by #rows_v
+  Eigen::MatrixXd DmidVS_;              // 3·#bones by r: source Jacobians at bone midpoints from Ys
+  Eigen::MatrixXd KtVa_;                // #N by N_a
+  double graph_scale_ = 1;              // s: target / source height (working units)
+  double graph_sp_len_ = 1, graph_vol_len_ = 1;  // ℓ, ℓ_v: mean edge lengths (rows divided by them)
 };
 
 }  // namespace mm

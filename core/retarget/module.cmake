@@ -4,7 +4,10 @@ list(APPEND MM_CORE_SOURCES
   core/retarget/bone_correspondence.cpp
   core/retarget/harmonic_synthesis.cpp
   core/retarget/harmonic_retarget.cpp
+  core/retarget/context_graph.cpp
+  core/retarget/nonrigid_icp.cpp
+  core/retarget/harmonic_retarget_graph.cpp
   core/retarget/lbs_baseline.cpp
   core/retarget/curve_skeleton.cpp
   core/retarget/joint_fitting.cpp)
-list(APPEND MM_TEST_SOURCES tests/retarget_test.cpp tests/joint_fitting_test.cpp)
+list(APPEND MM_TEST_SOURCES tests/retarget_test.cpp tests/joint_fitting_test.cpp tests/context_graph_test.cpp)

@@ -33,6 +33,9 @@ per frame (OUT_0000.obj, ...).
                            joints of the fit (chin, wrists, elbows, knees, groin, ...)
   --joint-map M.json       {"source joint": "target joint", ...} where names differ
   --frames a:b             shorthand for --first-frame a --last-frame b (either side optional)
+  --debug-graph OUT.glb    with --context-graph on: the context graph (source nodes, edges and body
+                           parts; compatible target nodes and edges; the target's volume graph) as
+                           glTF line and point sets
 options (app/retarget_job.h):
 )";
 
@@ -82,7 +85,12 @@ int run_retarget(const std::vector<std::string>& argv) {
                                                    "--markers pins the automatic joints: give it with --target-joints auto"));
     if (!(s = read_text(args.get("markers"), &markers_json)).ok()) return cli::report("retarget", s);
   }
+  const std::string graph_path = args.has("debug-graph") ? args.get("debug-graph") : "";
   if (!(s = cli::check_unused(args)).ok()) return cli::report("retarget", s);
+  if (!graph_path.empty() && !(opt.method == app::RetargetMethod::Harmonic && opt.harmonic.context_graph))
+    return cli::report("retarget", Status::error(StatusCode::InvalidArgument,
+                                                 "--debug-graph needs the harmonic method with --context-graph on"));
+  if (!graph_path.empty() && !(s = io::check_output_path(graph_path)).ok()) return cli::report("retarget", s);
 
   if (!(s = io::check_output_path(out_path)).ok()) return cli::report("retarget", s);
   io::LoadResult src = io::load_asset(src_path);
@@ -103,6 +111,16 @@ int run_retarget(const std::vector<std::string>& argv) {
   if (!s.ok()) return cli::report("retarget", s);
   const auto t1 = std::chrono::steady_clock::now();
   for (const auto& w : session.warnings()) std::cerr << "meshmorph retarget: warning: " << w << "\n";
+  if (!graph_path.empty()) {
+    std::vector<uint8_t> glb;
+    if (!(s = session.debug_graph_glb(&glb)).ok()) return cli::report("retarget", s);
+    if (!(s = io::write_file_atomic(graph_path, glb)).ok()) return cli::report("retarget", s);
+    const ContextGraphInfo& g = session.harmonic().context_graph();
+    std::cout << "  context graph: " << g.source_nodes.rows() << " nodes, " << g.edges.size() << " edges ("
+              << g.calibration_edges.size() << " at rest; rules removed " << g.counts.same_part << " same-part, "
+              << g.counts.too_long << " long, " << g.counts.interior << " interior), volume graph "
+              << g.volume_nodes.rows() << " nodes; wrote " << graph_path << "\n";
+  }
   std::vector<Eigen::MatrixXd> frames;
   s = session.frames(0, session.num_frames(), &frames, progress.sub(0.3, 0.95));
   if (!s.ok()) return cli::report("retarget", s);
