@@ -15,6 +15,10 @@
 //   retargetExportGlb(session, positions: Float32Array|Float64Array (all frames, frame-major))
 //                   → {ok, bytes: Uint8Array}
 //   retargetDispose(session) → boolean
+//   retargetGraph(session) → {ok, sets: [{name, positions: Float32Array (#P·3), lines: Uint32Array
+//                   (#L·2, empty = points), color: [r, g, b, a]}]}: the context graph (source nodes,
+//                   edges and parts in source units; target nodes, edges and volume graph in target
+//                   units); empty unless harmonic with context_graph on
 //   retargetJoints(sourceBytes, sourceName, targetBytes, targetName, markersJson: string ("" = none),
 //                  options?, progress?) → {ok, json: string ({"name": [x,y,z]}, for retargetPrepare's
 //                  targetJointsJson), names: string[], positions: Float32Array (#J·3, target
@@ -31,6 +35,7 @@
 
 #include "convert.h"
 #include "io/asset.h"
+#include "io/debug_lines_glb.h"
 #include "app/joints_job.h"
 #include "app/retarget_job.h"
 #include "guard.h"
@@ -127,6 +132,30 @@ emscripten::val retarget_export_glb(int id, emscripten::val positions) {
   return out;
 }
 
+// The session's context graph as overlay sets (RetargetJob::context_graph_overlay): empty
+// unless the harmonic method runs with context_graph on.
+emscripten::val retarget_graph(int id) {
+  auto it = retarget_sessions().find(id);
+  if (it == retarget_sessions().end())
+    return status_object(Status::error(StatusCode::InvalidArgument, "unknown retarget session"));
+  emscripten::val out = status_object(Status::success());
+  emscripten::val sets = emscripten::val::array();
+  for (const io::DebugGeometry& d : it->second.session->context_graph_overlay()) {
+    emscripten::val o = emscripten::val::object();
+    o.set("name", d.name);
+    o.set("positions", to_float32_array(d.P));
+    Eigen::MatrixXi L(static_cast<Eigen::Index>(d.lines.size()), 2);
+    for (size_t k = 0; k < d.lines.size(); ++k) L.row(static_cast<Eigen::Index>(k)) << d.lines[k].first, d.lines[k].second;
+    o.set("lines", to_uint32_array(L));
+    emscripten::val c = emscripten::val::array();
+    for (float x : d.color) c.call<void>("push", x);
+    o.set("color", c);
+    sets.call<void>("push", o);
+  }
+  out.set("sets", sets);
+  return out;
+}
+
 bool retarget_dispose(int id) { return retarget_sessions().erase(id) > 0; }
 
 emscripten::val retarget_joints(emscripten::val src, std::string src_name, emscripten::val tgt, std::string tgt_name,
@@ -173,4 +202,5 @@ EMSCRIPTEN_BINDINGS(meshmorph_retarget) {
   bind<&retarget_export_glb>("retargetExportGlb");
   bind<&retarget_dispose>("retargetDispose");
   bind<&retarget_joints>("retargetJoints");
+  bind<&retarget_graph>("retargetGraph");
 }

@@ -387,6 +387,18 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     // Clear pins: fitted again without them.
     await page.click('#rt-pins-clear');
     await page.waitForFunction(() => Object.keys(window.__meshmorph.state.retarget.pins).length === 0 && window.__meshmorph.state.retarget.fit.status === 'done' && window.__meshmorph.state.retarget.joints > 0, null, { timeout: 120000 });
+    await waitRun(page);
+    // The context graph (option context_graph on): a new run, then its graph over the target.
+    await page.click('#rt-edit-joints'); // editing off: the frames play again
+    await page.click('section.retarget .lil-gui.options > .lil-title');
+    await page.selectOption('#opt-context_graph', 'on');
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.graph.sets > 0, null, { timeout: 240000 });
+    await page.check('#rt-graph');
+    const withGraph = await rtState(page);
+    check(withGraph.run.options.context_graph === 'on' && withGraph.graph.nodes > 50 && withGraph.graph.edges > 50, `context graph: ${JSON.stringify(withGraph.graph)}`);
+    record(browser, 'retarget Fox → wolf: context graph over the target (sets / nodes / edges)', `${withGraph.graph.sets} / ${withGraph.graph.nodes} / ${withGraph.graph.edges}`);
+    await nextFrame(page);
+    await shot(page, 'retarget-17-context-graph');
     check(pageErrors.length === 0, `uncaught page errors: ${pageErrors.join(' | ')}`);
   });
 }

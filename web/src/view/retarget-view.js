@@ -58,6 +58,11 @@ export class RetargetView {
     this.jointMaterial = new THREE.MeshBasicMaterial({ color: 0xffd23f, depthTest: false, transparent: true });
     this.boneMaterial = new THREE.LineBasicMaterial({ color: 0x39e6a0, depthTest: false, transparent: true });
     this.pinnedMaterial = new THREE.MeshBasicMaterial({ color: 0xff4f6d, depthTest: false, transparent: true });
+    // Context-graph overlay (target coordinates): line and point sets.
+    this.graphGroup = new THREE.Group();
+    this.graphGroup.visible = false;
+    this.sides.target.root.add(this.graphGroup);
+    this.graph = [];
     this.joints = { spheres: [], lines: null, bones: [], count: 0 };
     this.dragging = -1; // the joint being dragged
     this.seeThrough = false;
@@ -213,6 +218,53 @@ export class RetargetView {
       });
       p.needsUpdate = true;
     }
+    this.viewer.requestRender();
+  }
+
+  // The context graph over the target: sets {positions (#P·3), lines (#L·2, empty = points),
+  // color [r, g, b, a]} in target coordinates.
+  setGraph(sets) {
+    this.clearGraph();
+    for (const set of sets) {
+      const geometry = new THREE.BufferGeometry();
+      geometry.setAttribute('position', new THREE.BufferAttribute(Float32Array.from(set.positions), 3));
+      const color = new THREE.Color(set.color[0], set.color[1], set.color[2]);
+      const common = { color, transparent: true, opacity: set.color[3] ?? 1, depthTest: false };
+      let object;
+      if (set.lines.length) {
+        geometry.setIndex(new THREE.BufferAttribute(Uint32Array.from(set.lines), 1));
+        object = new THREE.LineSegments(geometry, new THREE.LineBasicMaterial(common));
+      } else {
+        object = new THREE.Points(geometry, new THREE.PointsMaterial({ ...common, size: 5, sizeAttenuation: false }));
+      }
+      object.renderOrder = 2;
+      object.frustumCulled = false;
+      this.graphGroup.add(object);
+      this.graph.push(object);
+    }
+    this.viewer.requestRender();
+  }
+
+  // New positions of graph set i (the nodes following a frame).
+  moveGraph(i, positions) {
+    const a = this.graph[i]?.geometry.getAttribute('position');
+    if (!a || a.array.length !== positions.length) return;
+    a.array.set(positions);
+    a.needsUpdate = true;
+  }
+
+  clearGraph() {
+    for (const o of this.graph) {
+      this.graphGroup.remove(o);
+      o.geometry.dispose();
+      o.material.dispose();
+    }
+    this.graph = [];
+    this.viewer.requestRender();
+  }
+
+  setGraphVisible(on) {
+    this.graphGroup.visible = on;
     this.viewer.requestRender();
   }
 

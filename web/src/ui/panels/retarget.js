@@ -18,7 +18,8 @@
 //   4 play: the timeline under the view (ui/timeline.js: play / pause, scrub, speed, the
 //     computed frames drawn under the bar, the bone-length change per frame as a plot); source
 //     and target side by side or in split panes, in sync (view/retarget-view.js)
-//   5 export: the animated GLB (retargetExportGlb: one morph target per frame), the joints JSON;
+//   5 export: the animated GLB (retargetExportGlb: the job's export layout — per frame, or compact
+//     above 60 frames), the joints JSON;
 //     an animated GLB opened here plays on the target side with the same timeline.
 // State it owns (window.__meshmorph.state.retarget): {step, source ({id, name, family, clips,
 // clip, clipName}), target ({id, name, skinned, vertices}), jointsFrom ('skin' | 'file' | 'auto'),
@@ -119,10 +120,14 @@ const markup = `
     <label title="Two views, each with its own camera"><input type="radio" name="rt-view" value="split" /> Split</label>
     <label id="rt-link-row" hidden title="Orbiting one view moves the other the same way"><input type="checkbox" id="rt-link" checked /> Link the cameras</label>
   </div>
+  <div class="row">
+    <label title="The context graph of the run (paper 002 Sec. 6; option context_graph on): the target's graph nodes and edges and its volume graph, following the frames"><input type="checkbox" id="rt-graph" disabled /> Context graph</label>
+    <span id="rt-graph-info" class="hint"></span>
+  </div>
 
   <h3>Export</h3>
   <div class="row">
-    <button id="rt-export" type="button" title="The target with one morph target per frame and their animation (plays in three.js and Blender)">Download GLB</button>
+    <button id="rt-export" type="button" title="The animated target (plays in three.js and Blender): one morph target per frame, or for clips over 60 frames the compact export (the clip's mean and principal components within the option export_tolerance; option export)">Download GLB</button>
     <button id="rt-joints-save" type="button" title="The target's joints as the CLI's joints file">Download joints JSON</button>
   </div>
   <div class="row">
@@ -202,7 +207,7 @@ export const panel = {
       step: 0, source: null, target: null, jointsFrom: 'skin', joints: 0, method: 'harmonic',
       run: { status: 'idle' }, playing: false, time: 0, frame: -1, speed: 1, firstFrameMs: null,
       shownFrames: 0, runs: 0, exports: 0, played: null, view: 'side',
-      pins: {}, fit: { status: 'idle', fits: 0 }, editingJoints: false,
+      pins: {}, fit: { status: 'idle', fits: 0 }, editingJoints: false, graph: { sets: 0, nodes: 0, edges: 0 },
     };
     state.retarget = retarget;
 
@@ -240,6 +245,7 @@ export const panel = {
     let restLengths = null;
     let plot = null;     // Float64Array per frame: mean bone-length change (NaN = not yet)
     let crossings = null; // Float64Array per frame: self-intersecting triangle pairs (NaN = not yet)
+    let graph = null;    // {sets: [{positions, follower}]} of the run's context graph (target side)
     let shownBuffer = null;
     let form = null;
     let visible = false;
@@ -607,6 +613,7 @@ export const panel = {
     function showRest() {
       if (surface) view.setTargetPositions(surface.positions);
       if (joints) view.moveJoints(joints.positions.flat());
+      if (graph) graph.sets.forEach((set, i) => view.moveGraph(i, set.positions));
     }
     function setEditingJoints(on) {
       retarget.editingJoints = on;
@@ -774,12 +781,51 @@ export const panel = {
       timeline.setPlot(plot, label, { values: crossings, color: '#ff6b8a', legend: (m) => `intersections max ${Math.round(m)}` });
     }
 
+    // The context graph of a finished run (harmonic with context_graph on), over the target; its
+    // nodes follow the frames by their nearest rest vertices.
+    async function loadGraph(session) {
+      graph = null;
+      view.clearGraph();
+      retarget.graph = { sets: 0, nodes: 0 };
+      $('rt-graph').disabled = true;
+      $('rt-graph-info').textContent = '';
+      const opts = form ? form.values() : {};
+      if (retarget.method !== 'harmonic' || !(opts.context_graph === true || opts.context_graph === 'on') || session == null) {
+        $('rt-graph-info').textContent = 'on with the option context_graph (harmonic)';
+        return;
+      }
+      try {
+        const r = await client.run('retargetGraph', { session }).promise;
+        if (!surface || session !== runner.session) return;
+        const sets = [];
+        r.info.sets.forEach((set, i) => {
+          if (set.source) return;
+          const positions = r.buffers[`set${i}Positions`];
+          const points = [];
+          for (let k = 0; k < positions.length; k += 3) points.push([positions[k], positions[k + 1], positions[k + 2]]);
+          sets.push({ positions, lines: r.buffers[`set${i}Lines`], color: set.color, name: set.name, follower: new JointFollower(surface.positions, points, 8) });
+        });
+        graph = { sets };
+        view.setGraph(sets);
+        view.setGraphVisible($('rt-graph').checked);
+        retarget.graph = { sets: sets.length, nodes: sets.reduce((n, x) => n + x.positions.length / 3, 0), edges: sets.reduce((n, x) => n + x.lines.length / 2, 0) };
+        $('rt-graph').disabled = false;
+        $('rt-graph-info').textContent = sets.map((x) => `${x.name}: ${x.lines.length ? `${x.lines.length / 2} edges` : `${x.positions.length / 3} nodes`}`).join(' · ');
+        applyTime();
+      } catch (e) {
+        if (e.code !== 'Cancelled') app.showError(e);
+      }
+    }
+    $('rt-graph').addEventListener('change', () => view.setGraphVisible($('rt-graph').checked));
+
     function clearRunDisplay() {
       store = null;
       surface = null;
       follower = null;
       plot = null;
       crossings = null;
+      graph = null;
+      view.clearGraph();
       retarget.frame = -1;
       retarget.shownFrames = 0;
       timeline.setBuffered([], 0);
@@ -854,6 +900,7 @@ export const panel = {
       }
       if (type === 'done') {
         run.status = 'done';
+        loadGraph(detail.session);
         run.framesMs = Math.round(performance.now() - run.preparedAt);
         runText(`${store.count} frames: prepared in ${(run.prepareMs / 1000).toFixed(2)} s, frames in ${(run.framesMs / 1000).toFixed(2)} s (${(run.framesMs / store.count).toFixed(1)} ms each, with transfers)`);
         refresh();
@@ -920,6 +967,7 @@ export const panel = {
       if (!at) return;
       view.setTargetPositions(shownBuffer);
       if (follower && joints) view.moveJoints(follower.at(shownBuffer));
+      if (graph) graph.sets.forEach((set, i) => view.moveGraph(i, set.follower.at(shownBuffer)));
       retarget.frame = at.frame;
       retarget.shownFrames += 1;
       preview.paused = retarget.playing;

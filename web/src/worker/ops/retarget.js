@@ -67,6 +67,21 @@ export const ops = {
       buffers: { positions: r.positions, skeletonPositions: r.skeletonPositions },
     };
   },
+  // The context graph of a session (harmonic with context_graph on): overlay sets.
+  // options: {session} → info {sets: [{name, color, source (true: source units)}]}, buffers
+  // {set0Positions, set0Lines, set1Positions, ...}
+  retargetGraph(ctx, options = {}) {
+    session(ctx, options.session);
+    const r = unwrap(ctx.module.retargetGraph(options.session));
+    const info = { sets: [] };
+    const buffers = {};
+    r.sets.forEach((set, i) => {
+      info.sets.push({ name: set.name, color: set.color, source: !set.name.startsWith('target') });
+      buffers[`set${i}Positions`] = set.positions;
+      buffers[`set${i}Lines`] = set.lines;
+    });
+    return { info, buffers };
+  },
   retargetDispose(ctx, options = {}) {
     ctx.state.retarget?.delete(options.session);
     return { info: { disposed: ctx.module.retargetDispose(options.session) }, buffers: {} };
