@@ -108,13 +108,17 @@ export class PlaywrightLikePage {
 
   selectOption(selector, value) { return this.page.select(selector, value); }
 
+  // The focus and blur events are dispatched as well: under Xvfb the window does not always have
+  // the focus, and then focus()/blur() fire nothing (lil-gui's finish-change listens to blur).
   fill(selector, value) {
     return this.page.evaluate((s, v) => {
       const input = document.querySelector(s);
       input.focus();
+      input.dispatchEvent(new FocusEvent('focus'));
       input.value = v;
       input.dispatchEvent(new Event('input', { bubbles: true }));
       input.dispatchEvent(new Event('change', { bubbles: true }));
+      input.dispatchEvent(new FocusEvent('blur'));
       input.blur();
     }, selector, value);
   }

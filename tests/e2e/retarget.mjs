@@ -242,7 +242,10 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     await page.click('section.retarget .lil-gui.options > .lil-title');
     await page.fill('#opt-fps', '15');
     await page.click('section.retarget h2'); // the field loses focus: lil-gui's finish-change
-    await page.waitForFunction((n) => window.__meshmorph.state.retarget.runs > n, runs, { timeout: 10000 });
+    await page.waitForFunction((n) => window.__meshmorph.state.retarget.runs > n, runs, { timeout: 10000 }).catch(async (e) => {
+      const st = await rtState(page);
+      throw new Error(`${e.message}: runs ${st.runs} (was ${runs}), run ${st.run.status}, fps field "${await page.inputValue('#opt-fps')}", options ${JSON.stringify(st.run.options).slice(0, 300)}`);
+    });
     const fewer = await waitRun(page);
     check(Math.abs(fewer.run.frames - Math.ceil(done.run.frames / 2)) <= 1, `fps 15: ${fewer.run.frames} frames vs ${done.run.frames} at 30`);
     await page.fill('#opt-fps', '30');
