@@ -182,6 +182,77 @@ JfLeafMatch jf_match_leaves(const std::vector<Eigen::Vector3d>& S, const std::ve
   return m;
 }
 
+// The source's joint tree as a skeleton (SourceSkeleton::Bones): nodes = the joints of `used`
+// in the largest connected part of the hierarchy (parent = nearest used ancestor), plus one tip
+// node per leaf joint, where its bone, prolonged, leaves the source's solid — the limb's end, as
+// the target's curve skeleton ends at the tip of the limb. Radius = distance to the surface. The
+// volume is the voxel skeleton's (for the facing test). Joints of other parts (IK helpers inside
+// the surface) are not nodes: they are placed from their closest point on the tree (step 5).
+CurveSkeleton jf_bone_skeleton(const CurveSkeleton& voxel, const JointSet& J, const std::vector<int>& used,
+                               const TriangleBvh& bvh) {
+  CurveSkeleton out;
+  out.volume = voxel.volume;
+  out.num_bridges = voxel.num_bridges;
+  const int nj = J.size();
+  std::vector<uint8_t> is_used(nj, 0);
+  for (int j : used) is_used[j] = 1;
+  const bool has_tree = static_cast<int>(J.parent.size()) == nj;
+  std::vector<int> up(nj, -1);  // nearest used ancestor
+  for (int j : used) {
+    int p = has_tree ? J.parent[j] : -1;
+    while (p >= 0 && !is_used[p]) p = J.parent[p];
+    up[j] = p;
+  }
+  // Largest part: count used descendants of each top (used joint without a used ancestor).
+  std::vector<int> top(nj, -1), size(nj, 0);
+  for (int j : used) {
+    int t = j;
+    while (up[t] >= 0) t = up[t];
+    top[j] = t;
+    ++size[t];
+  }
+  int root = -1;
+  for (int j : used)
+    if (up[j] < 0 && (root < 0 || size[j] > size[root])) root = j;
+  if (root < 0) {
+    out.status = Status::error(StatusCode::InvalidArgument, "the source has no joints inside its surface");
+    return out;
+  }
+  std::vector<int> node_of(nj, -1), joint_of;
+  for (int j : used)
+    if (top[j] == root) node_of[j] = static_cast<int>(joint_of.size()), joint_of.push_back(j);
+  std::vector<int> children(nj, 0);
+  for (int j : joint_of)
+    if (up[j] >= 0) ++children[up[j]];
+  std::vector<Eigen::Vector3d> pos;
+  for (int j : joint_of) {
+    pos.push_back(J.P.row(j).transpose());
+    out.parent.push_back(up[j] >= 0 ? node_of[up[j]] : -1);
+  }
+  const double step = 0.25 * voxel.volume.grid.cell;
+  const double reach = (J.P.colwise().maxCoeff() - J.P.colwise().minCoeff()).norm() + 1.0;
+  for (int j : joint_of) {
+    if (children[j] > 0 || up[j] < 0) continue;
+    const Eigen::Vector3d a = J.P.row(up[j]).transpose(), b = J.P.row(j).transpose();
+    const Eigen::Vector3d d = b - a;
+    if (!(d.norm() > 0)) continue;
+    const Eigen::Vector3d u = d.normalized();
+    Eigen::Vector3d tip = b;
+    for (double s = step; s < reach && voxel.volume.contains(b + s * u); s += step) tip = b + s * u;
+    if ((tip - b).norm() < step) continue;
+    pos.push_back(tip);
+    out.parent.push_back(node_of[j]);
+  }
+  out.nodes.resize(static_cast<Eigen::Index>(pos.size()), 3);
+  out.radius.resize(static_cast<Eigen::Index>(pos.size()));
+  for (size_t i = 0; i < pos.size(); ++i) {
+    out.nodes.row(static_cast<Eigen::Index>(i)) = pos[i].transpose();
+    out.radius[static_cast<Eigen::Index>(i)] = std::max(std::sqrt(bvh.closest_point(pos[i]).sq_distance), step);
+  }
+  out.root = node_of[root];
+  return out;
+}
+
 std::string jf_join(const std::vector<std::string>& v, size_t limit = 10) {
   std::string s;
   for (size_t i = 0; i < v.size() && i < limit; ++i) s += (i ? ", " : "") + v[i];
@@ -211,14 +282,6 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
   r.target_skeleton = curve_skeleton(Vt, Ft, opt.skeleton, progress.sub(0.45, 0.9));
   if (!r.target_skeleton.status.ok())
     return fail(r.target_skeleton.status.code, "target skeleton: " + r.target_skeleton.status.message);
-  const CurveSkeleton& SS = r.source_skeleton;
-  const CurveSkeleton& TS = r.target_skeleton;
-  const JfTree st(SS), tt(TS);
-  const std::vector<int> s_leaves = SS.leaves(), t_leaves = TS.leaves();
-  if (s_leaves.size() < 2 || t_leaves.size() < 2)
-    return fail(StatusCode::InvalidMesh, std::string("the ") + (s_leaves.size() < 2 ? "source" : "target") +
-                                             " skeleton has fewer than 2 limb ends: the mesh is too broken or too "
-                                             "blob-like for automatic joints; place the joints with markers or a JSON file");
 
   // Source joints inside the source surface.
   TriangleBvh bvh_s(Vs, Fs), bvh_t(Vt, Ft);
@@ -232,6 +295,19 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
     else r.skipped.push_back(source_joints.names[j]);
   }
   if (used.size() < 2) return fail(StatusCode::InvalidArgument, "fewer than 2 source joints lie inside the source surface");
+  if (opt.source_skeleton == SourceSkeleton::Bones) {
+    r.source_skeleton = jf_bone_skeleton(r.source_skeleton, source_joints, used, bvh_s);
+    if (!r.source_skeleton.status.ok()) return fail(r.source_skeleton.status.code, r.source_skeleton.status.message);
+  }
+
+  const CurveSkeleton& SS = r.source_skeleton;
+  const CurveSkeleton& TS = r.target_skeleton;
+  const JfTree st(SS), tt(TS);
+  const std::vector<int> s_leaves = SS.leaves(), t_leaves = TS.leaves();
+  if (s_leaves.size() < 2 || t_leaves.size() < 2)
+    return fail(StatusCode::InvalidMesh, std::string("the ") + (s_leaves.size() < 2 ? "source" : "target") +
+                                             " skeleton has fewer than 2 limb ends: the mesh is too broken or too "
+                                             "blob-like for automatic joints; place the joints with markers or a JSON file");
 
   // 2. Up axes.
   const Eigen::Vector3d us = jf_axis(opt.source_up);
@@ -386,7 +462,10 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
     if (!lost.empty())
       return fail(StatusCode::InvalidArgument,
                   "topology mismatch: no limb of the target matches the source's chain ending at " + jf_join(lost) +
-                      "; " + counts + ". Use a source of the target's kind, or pin those joints with markers");
+                      "; " + counts + ". Use a source of the target's kind, pin those joints with markers" +
+                      (opt.source_skeleton == SourceSkeleton::Voxel
+                           ? ", or fit the source's own bones (source_skeleton bones: for blocky, many-part sources)"
+                           : ""));
   }
   if (match.pairs.size() < 2)
     return fail(StatusCode::InvalidArgument, "fewer than 2 limb ends of the target match the source's: place the joints with markers");

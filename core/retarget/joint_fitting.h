@@ -40,8 +40,21 @@
 
 namespace mm {
 
+// Which tree stands for the source in steps 4–5.
+// Voxel is the default: both sides are cut alike, so proportions along branches compare
+// (self-fits ≤ 1% of the height). Bones fits sources whose curve skeleton has far more limb ends
+// than their rig (KayKit's blocky parts: 24 ends for 5 limbs), which Voxel refuses as a topology
+// mismatch; measured KayKit Knight → human_woman: 13% of the height from the hand-placed joints
+// (the woman's legs touch, so her skeleton forks low), vs 20% for Voxel without the check.
+enum class SourceSkeleton {
+  Voxel,   // the source's curve skeleton, cut like the target's (both sides measured alike)
+  Bones,   // the source's own joint tree (joints inside its surface), each leaf bone prolonged
+           // along its direction to the surface (the limb's tip)
+};
+
 struct JointFitOptions {
-  CurveSkeletonOptions skeleton;  // both shapes' skeletons
+  CurveSkeletonOptions skeleton;  // both shapes' skeletons (the source's volume is always voxelised)
+  SourceSkeleton source_skeleton = SourceSkeleton::Voxel;
   int source_up = 1;              // source up axis: 0..2 = +x,+y,+z, 3..5 = −x,−y,−z (glTF: 1)
   int target_up = -1;             // target up axis as source_up; −1 = detect from the limb ends
   int source_front = 2;           // source facing axis, as source_up (glTF: +z)
