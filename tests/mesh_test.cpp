@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <map>
 
 #include "io/asset.h"
 #include "mesh/midpoint_subdivide.h"
@@ -263,6 +264,64 @@ TEST(TopologyRealMesh, ClosedMeshesAreWatertightWithExpectedGenus) {
     EXPECT_EQ(r.euler_characteristic, c.euler) << c.file;
     EXPECT_TRUE(r.status(manifold_defects()).ok()) << c.file << ": " << r.to_text();
   }
+}
+
+// validate_mesh finds edges, boundary loops, non-manifold edges and vertices and orientation
+// flips in one pass over the corners around each vertex; the separate topology functions find
+// them each on their own. Both must agree on meshes with every kind of defect.
+TEST(Validate, OnePassTopologyAgreesWithTheSeparateFunctions) {
+  std::vector<std::pair<Eigen::MatrixXd, Eigen::MatrixXi>> meshes;
+  for (const char* file : {"pose/camel_ref.ply", "edit/hand_lowres.ply", "edit/cylinder_coarse.ply",
+                           "anim/Fox/glTF-Binary/Fox.glb", "anim/KayKit/Knight.glb"}) {
+    const io::LoadResult lr = io::load_asset(test::data_path(file));
+    ASSERT_TRUE(lr.status.ok()) << file << ": " << lr.status.message;
+    meshes.push_back({lr.asset.V_raw, lr.asset.F_raw});  // raw: seams, parts, open boundaries
+  }
+  {  // every defect at once: a fin (edge in 3 faces), a bow tie, a duplicate, a flipped face,
+     // a repeated index and an out-of-range index
+    Eigen::MatrixXd V;
+    Eigen::MatrixXi F;
+    test::grid(5, 4, &V, &F);
+    const int n = static_cast<int>(V.rows());
+    V.conservativeResize(n + 3, 3);
+    V.row(n) << 0.5, 0.5, 1;
+    V.row(n + 1) << 9, 9, 0;
+    V.row(n + 2) << 9, 10, 0;
+    Eigen::MatrixXi extra(6, 3);
+    extra << F(0, 0), F(0, 2), n, F(3, 0), n + 1, n + 2, F(5, 0), F(5, 1), F(5, 2), F(7, 0), F(7, 2), F(7, 1),
+        1, 1, 2, 0, 1, n + 7;
+    F.conservativeResize(F.rows() + 6, 3);
+    F.bottomRows(6) = extra;
+    meshes.push_back({V, F});
+  }
+  for (const auto& [V, F] : meshes) {
+    const int n = static_cast<int>(V.rows());
+    Eigen::MatrixXi Fv(F.rows(), 3);
+    int rows = 0;
+    for (int f = 0; f < F.rows(); ++f) {
+      const int a = F(f, 0), b = F(f, 1), c = F(f, 2);
+      if (a >= 0 && b >= 0 && c >= 0 && a < n && b < n && c < n && a != b && b != c && a != c) Fv.row(rows++) = F.row(f);
+    }
+    Fv.conservativeResize(rows, 3);
+    const MeshReport r = validate_mesh(V, F);
+    const std::vector<EdgeUse> edges = edge_uses(Fv);
+    int fins = 0;
+    for (const EdgeUse& e : edges) fins += e.faces > 2;
+    EXPECT_EQ(r.num_edges, static_cast<int>(edges.size()));
+    EXPECT_EQ(r.count(MeshDefect::NonManifoldEdge), fins);
+    EXPECT_EQ(r.boundary_loops, boundary_loops(Fv, n));
+    EXPECT_EQ(r.count(MeshDefect::NonManifoldVertex), static_cast<int>(non_manifold_vertices(Fv, n).size()));
+    std::map<std::pair<int, int>, int> directed;
+    for (int f = 0; f < rows; ++f)
+      for (int c = 0; c < 3; ++c) ++directed[{Fv(f, c), Fv(f, (c + 1) % 3)}];
+    int flips = 0;
+    for (const auto& [h, count] : directed) flips += count > 1;
+    EXPECT_EQ(r.count(MeshDefect::InconsistentOrientation), flips);
+  }
+  const MeshReport all = validate_mesh(meshes.back().first, meshes.back().second);
+  for (MeshDefect d : {MeshDefect::NonManifoldEdge, MeshDefect::NonManifoldVertex, MeshDefect::DuplicateFace,
+                       MeshDefect::InconsistentOrientation, MeshDefect::DegenerateFace, MeshDefect::IndexOutOfRange})
+    EXPECT_GT(all.count(d), 0) << mesh_defect_name(d) << "\n" << all.to_text();
 }
 
 // The 1→4 subdivision the big-input tests and benches use: #F × 4, #V + #E vertices, the same

@@ -35,7 +35,11 @@ nlohmann::json mesh_report_json(const MeshReport& r) {
 InfoReport info_report(const Asset& asset) {
   InfoReport out;
   out.welded = validate_mesh(asset.weld.V, asset.weld.F);
-  out.raw = validate_mesh(asset.V_raw, asset.F_raw);
+  // The raw layout is validated again only where welding changed it (glTF seams, duplicates).
+  const bool same = asset.V_raw.rows() == asset.weld.V.rows() && asset.F_raw.rows() == asset.weld.F.rows() &&
+                    asset.V_raw.cols() == asset.weld.V.cols() && asset.F_raw.cols() == asset.weld.F.cols() &&
+                    asset.F_raw == asset.weld.F && asset.V_raw == asset.weld.V;
+  out.raw = same ? out.welded : validate_mesh(asset.V_raw, asset.F_raw);
 
   nlohmann::json j;
   j["file"] = asset.source_name;

@@ -253,8 +253,14 @@ Status load_ply(const std::vector<uint8_t>& bytes, Asset* asset) {
       return fail(StatusCode::ParseError, "PLY header declares " + std::to_string(e.count) + " " + quoted(e.name) +
                                               " elements but the data is too short to hold them");
     for (PlyProperty& p : e.properties) {
-      if (p.is_list) p.offsets.reserve(e.count + 1), p.offsets.push_back(0);
-      else p.values.reserve(e.count);
+      if (p.is_list) {
+        // Triangles, mostly; never more items than the remaining bytes can hold.
+        const size_t item = doc->encoding == PlyEncoding::Ascii ? 2 : ply_type_size(p.type);
+        p.offsets.reserve(e.count + 1), p.offsets.push_back(0);
+        p.values.reserve(std::min(3 * e.count, data.remaining() / std::max<size_t>(1, item)));
+      } else {
+        p.values.reserve(e.count);
+      }
     }
     for (size_t r = 0; r < e.count; ++r) {
       for (PlyProperty& p : e.properties) {

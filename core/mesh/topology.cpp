@@ -188,17 +188,21 @@ std::vector<std::vector<int>> boundary_loops(const Eigen::MatrixXi& F, int n) {
       k = e;
     }
   }
-  std::vector<int> out_start(static_cast<size_t>(n) + 1, 0);
+  std::vector<std::pair<int, int>> half_edges;
   for (int f = 0; f < nf; ++f)
     for (int c = 0; c < 3; ++c)
-      if (single[3 * f + c]) ++out_start[F(f, c) + 1];
+      if (single[3 * f + c]) half_edges.push_back({F(f, c), F(f, (c + 1) % 3)});
+  return chain_boundary_loops(n, half_edges);
+}
+
+std::vector<std::vector<int>> chain_boundary_loops(int n, const std::vector<std::pair<int, int>>& half_edges) {
+  std::vector<int> out_start(static_cast<size_t>(n) + 1, 0);
+  for (const auto& h : half_edges) ++out_start[h.first + 1];
   for (int v = 0; v < n; ++v) out_start[v + 1] += out_start[v];
   std::vector<int> next(out_start[n]);  // outgoing boundary half-edges per vertex, ascending
   {
     std::vector<int> fill(out_start.begin(), out_start.end() - 1);
-    for (int f = 0; f < nf; ++f)
-      for (int c = 0; c < 3; ++c)
-        if (single[3 * f + c]) next[fill[F(f, c)]++] = F(f, (c + 1) % 3);
+    for (const auto& h : half_edges) next[fill[h.first]++] = h.second;
   }
   std::vector<int> cursor(out_start.begin(), out_start.end() - 1);
   for (int v = 0; v < n; ++v) std::sort(next.begin() + out_start[v], next.begin() + out_start[v + 1]);

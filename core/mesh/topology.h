@@ -4,6 +4,7 @@
 #pragma once
 
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -39,6 +40,10 @@ Eigen::VectorXi vertex_components(const Eigen::MatrixXi& F, int n, int* count);
 // each loop starts at its smallest vertex. Boundary edges that do not close into a loop
 // (non-manifold boundaries) end their chain where it cannot be continued.
 std::vector<std::vector<int>> boundary_loops(const Eigen::MatrixXi& F, int n);
+// The loops of given boundary half-edges a→b (each vertex's outgoing ones taken in ascending
+// order, loops started at the smallest vertex with one left): boundary_loops' second half, for
+// callers that found the boundary edges themselves (validate_mesh). Vertices in [0, n).
+std::vector<std::vector<int>> chain_boundary_loops(int n, const std::vector<std::pair<int, int>>& half_edges);
 
 // Items 0..count-1 grouped by a vertex key in [0, n) by a counting sort (linear time): the items
 // of vertex v are items[start[v]] .. items[start[v + 1] - 1], in increasing item order. key(i)

@@ -168,73 +168,100 @@ MeshReport validate_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   for (int v = 0; v < n; ++v)
     if (!referenced[v]) unreferenced.add_lazy([&] { return "vertex " + std::to_string(v); });
 
-  // Duplicate faces: same sorted vertex triple (faces bucketed by their smallest vertex, then
-  // sorted within the bucket: linear overall).
-  {
-    const VertexBuckets by_min = bucket_by_vertex(n, static_cast<int>(valid.size()), [&](int i) {
-      const int f = valid[i];
-      const int x = F(f, 0), y = F(f, 1), z = F(f, 2);
-      return (x == y || y == z || x == z) ? -1 : std::min(x, std::min(y, z));
-    });
-    std::vector<std::pair<std::array<int, 3>, int>> keys;
-    for (int v = 0; v < n; ++v) {
-      if (by_min.start[v + 1] - by_min.start[v] < 2) continue;
-      keys.clear();
-      for (int k = by_min.start[v]; k < by_min.start[v + 1]; ++k) {
-        const int f = valid[by_min.items[k]];
-        std::array<int, 3> t{F(f, 0), F(f, 1), F(f, 2)};
+  // Topology over valid, non-repeating faces (Fv; orig = their input rows), in one pass over
+  // the corners around each vertex v (linear: one bucketing, then small per-vertex sorts). Each
+  // corner of a face at v gives a spoke to its next vertex (half-edge v→next) and one to its
+  // previous vertex (half-edge prev→v). Per neighbour w of v: the v→w count finds inconsistent
+  // orientation; for w > v, the count of both directions is the number of faces on edge {v, w}
+  // (> 2: non-manifold; 1: boundary); faces sharing a spoke form fans (> 1 fan: non-manifold
+  // vertex); faces whose smallest vertex is v are compared for duplicates. Examples come in
+  // ascending vertex order, as from edge_uses / non_manifold_vertices / boundary_loops.
+  Eigen::MatrixXi Fv(valid.size(), 3);
+  std::vector<int> orig;
+  orig.reserve(valid.size());
+  int rows = 0;
+  for (int f : valid)
+    if (F(f, 0) != F(f, 1) && F(f, 1) != F(f, 2) && F(f, 0) != F(f, 2)) {
+      Fv.row(rows++) = F.row(f);
+      orig.push_back(f);
+    }
+  Fv.conservativeResize(rows, 3);
+
+  const VertexBuckets corners = bucket_by_vertex(n, rows * 3, [&](int h) { return Fv(h / 3, h % 3); });
+  struct Spoke {
+    int w;     // the other vertex
+    int out;   // 1: half-edge v→w (w follows v in the face), 0: w→v
+    int face;  // local face index at v
+    bool operator<(const Spoke& o) const {
+      return w != o.w ? w < o.w : out != o.out ? out < o.out : face < o.face;
+    }
+  };
+  std::vector<Spoke> spokes;
+  std::vector<int> parent;
+  std::vector<std::pair<std::array<int, 3>, int>> keys;
+  std::vector<std::pair<int, int>> boundary;  // boundary half-edges a→b
+  int num_edges = 0;
+  for (int v = 0; v < n; ++v) {
+    const int c0 = corners.start[v], c1 = corners.start[v + 1], nc = c1 - c0;
+    if (nc == 0) continue;
+    spokes.clear();
+    keys.clear();
+    for (int k = 0; k < nc; ++k) {
+      const int h = corners.items[c0 + k], f = h / 3, c = h % 3;
+      const int next = Fv(f, (c + 1) % 3), prev = Fv(f, (c + 2) % 3);
+      spokes.push_back({next, 1, k});
+      spokes.push_back({prev, 0, k});
+      if (v < next && v < prev) {
+        std::array<int, 3> t{Fv(f, 0), Fv(f, 1), Fv(f, 2)};
         std::sort(t.begin(), t.end());
-        keys.push_back({t, f});
+        keys.push_back({t, orig[f]});
       }
+    }
+    std::sort(spokes.begin(), spokes.end());
+    parent.resize(nc);
+    std::iota(parent.begin(), parent.end(), 0);
+    auto find = [&parent](int x) {
+      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    for (size_t i = 0; i < spokes.size();) {
+      size_t e = i;
+      int outs = 0;
+      while (e < spokes.size() && spokes[e].w == spokes[i].w) {
+        outs += spokes[e].out;
+        if (e > i) {
+          const int ra = find(spokes[e].face), rb = find(spokes[e - 1].face);
+          if (ra != rb) parent[ra] = rb;
+        }
+        ++e;
+      }
+      const int w = spokes[i].w, uses = static_cast<int>(e - i);
+      if (outs >= 2)
+        orientation.add_lazy([&] { return "edge " + std::to_string(v) + "->" + std::to_string(w) + " appears twice"; });
+      if (w > v) {
+        ++num_edges;
+        if (uses > 2)
+          nm_edge.add_lazy([&] {
+            return "edge " + std::to_string(v) + "-" + std::to_string(w) + " in " + std::to_string(uses) + " faces";
+          });
+        if (uses == 1) boundary.push_back(outs == 1 ? std::make_pair(v, w) : std::make_pair(w, v));
+      }
+      i = e;
+    }
+    if (nc >= 2) {
+      int fans = 0;
+      for (int k = 0; k < nc; ++k) fans += find(k) == k;
+      if (fans > 1)
+        nm_vertex.add_lazy([&] { return "vertex " + std::to_string(v) + " joins " + std::to_string(fans) + " fans"; });
+    }
+    if (keys.size() >= 2) {
       std::sort(keys.begin(), keys.end());
       for (size_t i = 1; i < keys.size(); ++i)
         if (keys[i].first == keys[i - 1].first)
           duplicate.add(face_str(F, keys[i].second) + " repeats face " + std::to_string(keys[i - 1].second));
     }
   }
-
-  // Topology over valid, non-repeating faces.
-  Eigen::MatrixXi Fv(valid.size(), 3);
-  int rows = 0;
-  for (int f : valid)
-    if (F(f, 0) != F(f, 1) && F(f, 1) != F(f, 2) && F(f, 0) != F(f, 2)) Fv.row(rows++) = F.row(f);
-  Fv.conservativeResize(rows, 3);
-
-  const auto edges = edge_uses(Fv);
-  rep.num_edges = static_cast<int>(edges.size());
-  for (const auto& e : edges)
-    if (e.faces > 2)
-      nm_edge.add_lazy([&] {
-        return "edge " + std::to_string(e.i) + "-" + std::to_string(e.j) + " in " +
-               std::to_string(e.faces) + " faces";
-      });
-
-  // Orientation: a directed edge used twice means two neighbours disagree on winding (half-edges
-  // bucketed by their first vertex).
-  {
-    const VertexBuckets by_from = bucket_by_vertex(n, rows * 3, [&](int h) { return Fv(h / 3, h % 3); });
-    std::vector<int> to;
-    for (int v = 0; v < n; ++v) {
-      if (by_from.start[v + 1] - by_from.start[v] < 2) continue;
-      to.clear();
-      for (int k = by_from.start[v]; k < by_from.start[v + 1]; ++k) {
-        const int h = by_from.items[k];
-        to.push_back(Fv(h / 3, (h % 3 + 1) % 3));
-      }
-      std::sort(to.begin(), to.end());
-      for (size_t i = 1; i < to.size(); ++i)
-        if (to[i] == to[i - 1] && (i < 2 || to[i - 2] != to[i]))
-          orientation.add_lazy([&] {
-            return "edge " + std::to_string(v) + "->" + std::to_string(to[i]) + " appears twice";
-          });
-    }
-  }
-
-  // Non-manifold vertices: the faces around a vertex must form one fan (mesh/topology.h).
-  for (const VertexFans& nv : non_manifold_vertices(Fv, n))
-    nm_vertex.add_lazy([&] {
-      return "vertex " + std::to_string(nv.vertex) + " joins " + std::to_string(nv.fans) + " fans";
-    });
+  rep.num_edges = num_edges;
 
   // Components and boundary loops over referenced vertices.
   int ncomp = 0;
@@ -247,7 +274,7 @@ MeshReport validate_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   for (int c = 0; c < ncomp; ++c)
     if (comp_has_ref[c] && comp_faces[c] > 0) rep.component_sizes.push_back(comp_faces[c]);
   rep.num_components = static_cast<int>(rep.component_sizes.size());
-  rep.boundary_loops = boundary_loops(Fv, n);
+  rep.boundary_loops = chain_boundary_loops(n, boundary);
   int nref = 0;
   for (int v = 0; v < n; ++v) nref += referenced[v];
   rep.euler_characteristic = nref - rep.num_edges + rows;
