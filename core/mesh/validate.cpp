@@ -90,6 +90,7 @@ Status check_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
 namespace {
 
 struct DefectCounter {
+  explicit DefectCounter(MeshDefect d) : defect(d) {}
   MeshDefect defect;
   int count = 0;
   std::string example;

@@ -136,9 +136,11 @@ WeldResult weld_vertices(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, con
   };
   CellTable table(static_cast<size_t>(n));
   std::vector<int> cell(n, -1);
-  std::vector<Eigen::Array3d> fracs(n);
-  for (int v = 0; v < n; ++v)
-    if (finite[v]) cell[v] = table.insert(cell_key(v, &fracs[v]));
+  {
+    Eigen::Array3d unused;
+    for (int v = 0; v < n; ++v)
+      if (finite[v]) cell[v] = table.insert(cell_key(v, &unused));
+  }
   // Vertices per cell, ascending (CSR).
   const int cells = table.size();
   std::vector<int> start(cells + 1, 0), members(n);
@@ -178,7 +180,8 @@ WeldResult weld_vertices(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, con
       if (cell[a] < 0) continue;
       for (int i = start[cell[a]]; i < start[cell[a] + 1]; ++i)
         if (members[i] > a && close(a, members[i])) unite(a, members[i]);
-      const Eigen::Array3d& frac = fracs[a];
+      Eigen::Array3d frac;  // recomputed rather than stored (24 bytes a vertex: 24 MB at 1M)
+      const CellTable::Key k = cell_key(a, &frac);
       int lo_d[3], hi_d[3];
       bool near_side = false;
       for (int ax = 0; ax < 3; ++ax) {
@@ -187,8 +190,6 @@ WeldResult weld_vertices(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, con
         near_side = near_side || lo_d[ax] || hi_d[ax];
       }
       if (!near_side) continue;
-      Eigen::Array3d unused;
-      const CellTable::Key k = cell_key(a, &unused);
       for (int dx = lo_d[0]; dx <= hi_d[0]; ++dx)
         for (int dy = lo_d[1]; dy <= hi_d[1]; ++dy)
           for (int dz = lo_d[2]; dz <= hi_d[2]; ++dz) {

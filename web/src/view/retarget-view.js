@@ -6,6 +6,7 @@
 // Each side is scaled to the same display height and stands on the same floor; its placement is
 // fixed from its rest pose, so root motion shows.
 import * as THREE from 'three';
+import { insideTest, lastInside } from './inside.js';
 
 const sphere = new THREE.SphereGeometry(1, 14, 10);
 const gap = 0.35; // between the two characters, in display heights
@@ -188,8 +189,10 @@ export class RetargetView {
     const box = this.sides.target.box;
     const size = box ? box.getSize(new THREE.Vector3()).y || box.getSize(new THREE.Vector3()).length() : 1;
     const radius = 0.012 * size;
+    // Pins stay red when the same joints are drawn again (a new run redraws them).
+    const pinned = this.pinned ?? new Set();
     for (let j = 0; j < count; ++j) {
-      const s = new THREE.Mesh(sphere, this.jointMaterial);
+      const s = new THREE.Mesh(sphere, pinned.has(j) ? this.pinnedMaterial : this.jointMaterial);
       s.scale.setScalar(radius);
       s.renderOrder = 3;
       this.jointGroup.add(s);
@@ -271,13 +274,16 @@ export class RetargetView {
   // Pinned joints (indices) drawn in their own colour.
   setPinned(indices) {
     const pinned = new Set(indices);
+    this.pinned = pinned;
     this.joints.spheres.forEach((s, j) => { s.material = pinned.has(j) ? this.pinnedMaterial : this.jointMaterial; });
     this.viewer.requestRender();
   }
 
   // Joint spheres the person can drag with the primary button (the orbit controls do not see
-  // that press). The joint moves in the plane through it facing the camera; onDrop(j, [x, y, z])
-  // in target coordinates when the button goes up. canDrag() says whether dragging is on now.
+  // that press). The joint moves in the plane through it facing the camera and stays inside the
+  // target: where the pointer leaves the mesh, the joint stops at the surface (inside.js);
+  // onDrop(j, [x, y, z]) in target coordinates when the button goes up. canDrag() says whether
+  // dragging is on now.
   // Returns a function that detaches the listeners.
   attachJointDrag({ canDrag = () => true, onDrop = () => {} }) {
     const canvas = this.viewer.renderer.domElement;
@@ -301,7 +307,17 @@ export class RetargetView {
       const world = this.joints.spheres[j].getWorldPosition(new THREE.Vector3());
       const normal = camera.getWorldDirection(new THREE.Vector3());
       const flat = this.joints.spheres.flatMap((s) => s.position.toArray());
-      drag = { j, plane: new THREE.Plane().setFromNormalAndCoplanarPoint(normal, world), flat, pointerId: e.pointerId };
+      // The inside test of the rest surface shown now (built once per drag: tens of ms at 50k faces).
+      if (!this.insideCache || this.insideCache.geometry !== this.targetMesh.geometry) {
+        const g = this.targetMesh.geometry;
+        this.insideCache = { geometry: g, inside: insideTest(g.getAttribute('position').array, g.index.array) };
+      }
+      const start = this.joints.spheres[j].position.clone();
+      const inside = this.insideCache.inside;
+      drag = {
+        j, plane: new THREE.Plane().setFromNormalAndCoplanarPoint(normal, world), flat, pointerId: e.pointerId,
+        inside, last: inside(start) ? start : null,
+      };
       this.dragging = j;
       window.addEventListener('pointermove', move, true);
       window.addEventListener('pointerup', up, true);
@@ -309,8 +325,12 @@ export class RetargetView {
     const move = (e) => {
       if (!drag || e.pointerId !== drag.pointerId) return;
       e.stopPropagation();
-      const p = local(e.clientX, e.clientY);
+      let p = local(e.clientX, e.clientY);
       if (!p) return;
+      // Keep the joint inside: past the surface it stops where the segment from its last inside
+      // position leaves the mesh (a joint that started outside moves freely until it is in).
+      if (drag.inside(p)) drag.last = p.clone();
+      else if (drag.last) p = lastInside(drag.inside, drag.last, p);
       drag.flat.splice(3 * drag.j, 3, p.x, p.y, p.z);
       this.moveJoints(drag.flat);
     };

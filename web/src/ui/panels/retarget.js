@@ -31,7 +31,8 @@
 // shownFrames, runs, exports, played ({name, duration, morphTargets} of an opened GLB)}.
 // Test hooks (window.__meshmorph.hooks): retargetFrame(k) → frame k's positions (array) or null,
 // retargetShown() → the target positions on screen, retargetJoints() → {names, positions},
-// retargetSeek(t), retargetJointOnScreen(j) → {x, y}, retargetCamera() → the camera position.
+// retargetSeek(t), retargetJointOnScreen(j) → {x, y}, retargetCamera() → the camera position,
+// retargetPinnedDrawn() → the joints drawn as pins (red).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
 import { clipOption, filterClips, jointsFileFor, familiesOf, librarySources, libraryTargets } from '../../lib/clip-library.js';
@@ -1131,6 +1132,7 @@ export const panel = {
     app.hooks.retargetTimes = () => (store ? Array.from(store.times) : null);
     app.hooks.retargetShown = () => Array.from(view.targetPositions() ?? []);
     // Where joint j's sphere is drawn now (it follows the frames unless joints are being edited).
+    app.hooks.retargetPinnedDrawn = () => view.joints.spheres.flatMap((sp, j) => (sp.material === view.pinnedMaterial ? [j] : []));
     app.hooks.retargetJointOnScreen = (j) => (view.joints.spheres[j] ? view.toScreen('target', view.joints.spheres[j].position.toArray()) : null);
     app.hooks.retargetJointAt = (x, y) => view.jointAt(x, y);
     app.hooks.retargetCamera = () => viewer.camera.position.toArray();
