@@ -276,7 +276,9 @@ CurveSkeleton jf_bone_skeleton(const CurveSkeleton& voxel, const JointSet& J, co
     out.parent.push_back(up[j] >= 0 ? node_of[up[j]] : -1);
   }
   const double step = 0.25 * voxel.volume.grid.cell;
-  const double reach = (J.P.colwise().maxCoeff() - J.P.colwise().minCoeff()).norm() + 1.0;
+  const UniformGrid& g = voxel.volume.grid;  // no walk inside the solid is longer than its grid's diagonal
+  const double reach = g.cell * std::sqrt(double(g.dims[0]) * g.dims[0] + double(g.dims[1]) * g.dims[1] +
+                                          double(g.dims[2]) * g.dims[2]);
   for (int j : joint_of) {
     if (children[j] > 0 || up[j] < 0) continue;
     const Eigen::Vector3d a = J.P.row(up[j]).transpose(), b = J.P.row(j).transpose();

@@ -45,7 +45,8 @@ namespace mm {
 // (self-fits ≤ 1% of the height). Bones fits sources whose curve skeleton has far more limb ends
 // than their rig (KayKit's blocky parts: 24 ends for 5 limbs), which Voxel refuses as a topology
 // mismatch; measured KayKit Knight → human_woman: 13% of the height from the hand-placed joints
-// (the woman's legs touch, so her skeleton forks low), vs 20% for Voxel without the check.
+// (the woman's legs touch, so her skeleton forks low). Measured by the joints' vertical span
+// instead: 15% for Bones, 20% for Voxel with the topology check off.
 enum class SourceSkeleton {
   Voxel,   // the source's curve skeleton, cut like the target's (both sides measured alike)
   Bones,   // the source's own joint tree (joints inside its surface), each leaf bone prolonged

@@ -307,7 +307,8 @@ export class RetargetView {
       const world = this.joints.spheres[j].getWorldPosition(new THREE.Vector3());
       const normal = camera.getWorldDirection(new THREE.Vector3());
       const flat = this.joints.spheres.flatMap((s) => s.position.toArray());
-      // The inside test of the rest surface shown now (built once per drag: tens of ms at 50k faces).
+      // The inside test of the rest surface (drags happen in the rest pose), built once per target
+      // surface: tens of ms at 50k faces.
       if (!this.insideCache || this.insideCache.geometry !== this.targetMesh.geometry) {
         const g = this.targetMesh.geometry;
         this.insideCache = { geometry: g, inside: insideTest(g.getAttribute('position').array, g.index.array) };
