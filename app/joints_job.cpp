@@ -20,8 +20,8 @@ const OptionSchema<JointsJobOptions>& joints_options() {
     s.number("prune_length", [](O& o) -> double& { return o.fit.skeleton.prune_length; }, 0, 1,
              "skeleton branches shorter than this × the longest side are removed");
     s.choice<SourceSkeleton>("source_skeleton", [](O& o) -> SourceSkeleton& { return o.fit.source_skeleton; },
-                             {{"voxel", SourceSkeleton::Voxel}, {"bones", SourceSkeleton::Bones}},
-                             "the source's tree: its curve skeleton (voxel), or its own bones with tips at the surface (bones: for blocky sources refused as a mismatch)");
+                             {{"auto", SourceSkeleton::Auto}, {"voxel", SourceSkeleton::Voxel}, {"bones", SourceSkeleton::Bones}},
+                             "the source's tree: its curve skeleton (voxel), its own bones with tips at the surface (bones: for blocky, many-part sources), or voxel and bones where a source limb finds no partner (auto)");
     s.integer("source_up", [](O& o) -> int& { return o.fit.source_up; }, 0, 5,
               "source up axis: 0..2 = +x,+y,+z, 3..5 = -x,-y,-z (glTF: 1)");
     s.integer("target_up", [](O& o) -> int& { return o.fit.target_up; }, -1, 5,

@@ -41,13 +41,15 @@
 namespace mm {
 
 // Which tree stands for the source in steps 4–5.
-// Voxel is the default: both sides are cut alike, so proportions along branches compare
-// (self-fits ≤ 1% of the height). Bones fits sources whose curve skeleton has far more limb ends
-// than their rig (KayKit's blocky parts: 24 ends for 5 limbs), which Voxel refuses as a topology
-// mismatch; measured KayKit Knight → human_woman: 13% of the height from the hand-placed joints
-// (the woman's legs touch, so her skeleton forks low). Measured by the joints' vertical span
-// instead: 15% for Bones, 20% for Voxel with the topology check off.
+// Voxel: both sides are cut alike, so proportions along branches compare (self-fits ≤ 1% of the
+// height). Bones fits sources whose curve skeleton has far more limb ends than their rig
+// (KayKit's blocky parts: 24 ends for 5 limbs), which Voxel refuses as a topology mismatch;
+// measured KayKit Knight → human_woman: 13% of the height from the hand-placed joints (the
+// woman's legs touch, so her skeleton forks low). Measured by the joints' vertical span instead:
+// 15% for Bones, 20% for Voxel with the topology check off. Bones as the only mode is worse where
+// Voxel fits (Knight self-fit 3%, Fox → wolf0 12% vs 8.7%), hence Auto.
 enum class SourceSkeleton {
+  Auto,    // Voxel; where a source limb finds no partner in the target, Bones (with a warning)
   Voxel,   // the source's curve skeleton, cut like the target's (both sides measured alike)
   Bones,   // the source's own joint tree (joints inside its surface), each leaf bone prolonged
            // along its direction to the surface (the limb's tip)
@@ -55,14 +57,15 @@ enum class SourceSkeleton {
 
 struct JointFitOptions {
   CurveSkeletonOptions skeleton;  // both shapes' skeletons (the source's volume is always voxelised)
-  SourceSkeleton source_skeleton = SourceSkeleton::Voxel;
+  SourceSkeleton source_skeleton = SourceSkeleton::Auto;
   int source_up = 1;              // source up axis: 0..2 = +x,+y,+z, 3..5 = −x,−y,−z (glTF: 1)
   int target_up = -1;             // target up axis as source_up; −1 = detect from the limb ends
   int source_front = 2;           // source facing axis, as source_up (glTF: +z)
   int target_front = -1;          // target facing axis; −1 = detect (step 3)
   double leaf_tolerance = 0.6;    // limb ends match when ≤ this × height apart (normalised shapes; mean of
                                   // the ends' and the back points' distances)
-  double back_length = 0.25;      // back point of a limb end: this × height up its path (pose-robust matching)
+  double back_length = 0.25;      // back point of a limb end: this × height up its path (pose-robust matching),
+  double back_limb_fraction = 0.5; // but at most this × the limb's length to its first branch point
   double ground_band = 0.12;      // limb ends below this × height count as standing on the ground
   double inside_tolerance = 0.01; // a joint within this × bbox diagonal outside the surface counts as inside
   int marker_reach = 3;           // markers move unpinned joints up to this many bones away (0 = only pin)
@@ -80,6 +83,7 @@ struct JointFitResult {
   std::vector<std::string> skipped;   // source joints not placed (outside the source surface)
   std::vector<std::string> warnings;
   CurveSkeleton source_skeleton, target_skeleton;
+  SourceSkeleton source_tree = SourceSkeleton::Voxel;  // the tree the result was fitted on (Voxel or Bones)
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // target axes → source axes (axis-aligned)
   int target_up = 1;              // detected or given up axis of the target (as JointFitOptions)
   std::vector<std::pair<int, int>> limb_ends;  // matched leaves (source node, target node)

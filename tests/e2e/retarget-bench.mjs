@@ -5,6 +5,10 @@
 // keeps the worker busy. Prints the time from choosing the clip to its first shown frame, the
 // rendered frames per second of the view and the target updates per second while frames are
 // computing and after the last one arrived, and the longest main-thread task in each window.
+// Then, playback paused, the renderer's own ceiling on this machine: the view redrawn in a
+// requestAnimationFrame loop with nothing else to do (the same scene; then only the target
+// surface, opaque: one lit 7k-vertex mesh), so a low playback rate can be told apart from the
+// page's own per-frame work (on a GPU-less machine Chromium renders WebGL with SwiftShader).
 // Needs the built page (node tests/e2e/run.mjs builds it; or `npm run build:web`).
 // Usage: MM_WASM_DIR=… node tests/e2e/retarget-bench.mjs [fps = 120] [seconds after = 3]
 import fs from 'node:fs';
@@ -85,12 +89,43 @@ async function main() {
     const end = await sample(page);
     const after = rates(done, end);
     const longAfter = await longest(page, done.t, end.t);
+    // The renderer's ceiling: playback paused, the view redrawn back to back for 2 s.
+    await page.click('#rt-play');
+    await page.waitForFunction(() => !window.__meshmorph.state.retarget.playing, null, { timeout: 5000 });
+    const renderLoop = (onlySurface) => page.evaluate(async (only) => {
+      const v = window.__meshmorph.viewer;
+      const hidden = [];
+      let surface = null;
+      v.scene.traverse((o) => { if (o.name === 'retarget-target-surface') surface = o; });
+      const saved = { transparent: surface.material.transparent, opacity: surface.material.opacity, depthWrite: surface.material.depthWrite };
+      if (only) {
+        v.scene.traverse((o) => { if ((o.isMesh || o.isLine || o.isPoints) && o !== surface && o.visible) { o.visible = false; hidden.push(o); } });
+        Object.assign(surface.material, { transparent: false, opacity: 1, depthWrite: true });
+        surface.material.needsUpdate = true;
+      }
+      v.render();
+      const t0 = performance.now();
+      let n = 0;
+      await new Promise((resolve) => {
+        const step = () => { v.render(); n += 1; if (performance.now() - t0 < 2000) requestAnimationFrame(step); else resolve(); };
+        requestAnimationFrame(step);
+      });
+      const fps = (n * 1000) / (performance.now() - t0);
+      for (const o of hidden) o.visible = true;
+      Object.assign(surface.material, saved);
+      surface.material.needsUpdate = true;
+      return fps;
+    }, onlySurface);
+    const sceneLoop = await renderLoop(false);
+    const surfaceLoop = await renderLoop(true);
+    const size = await page.evaluate(() => window.__meshmorph.viewer.size);
     const load = `load average ${os.loadavg()[0].toFixed(1)} on ${os.cpus().length} cores`;
     console.log(`Knight Sit_Floor_Idle → human_woman (${vertices} vertices), ${state.run.frames} frames at ${fps} fps; clip chosen → first frame shown ${state.firstFrameMs} ms (prepare ${state.run.prepareMs} ms)`);
     console.log(`  while computing (${during.seconds.toFixed(1)} s, ${during.frames} frames arrived): ${during.fps.toFixed(1)} rendered frames/s, ${during.updates.toFixed(1)} target updates/s, longest main-thread task ${longDuring.toFixed(0)} ms`);
     const slow = await page.evaluate(({ from, to }) => window.__longFrames.filter((f) => f.start >= from && f.start <= to).sort((a, b) => b.duration - a.duration).slice(0, 3), { from: first.t - 15000, to: done.t });
     for (const f of slow) console.log(`  slow frame ${f.duration.toFixed(0)} ms (blocking ${f.blocking.toFixed(0)} ms): ${f.scripts.join(' | ') || 'no script (rendering / the GPU process)'}`);
     console.log(`  after the last frame (${after.seconds.toFixed(1)} s): ${after.fps.toFixed(1)} rendered frames/s, ${after.updates.toFixed(1)} target updates/s, longest main-thread task ${longAfter.toFixed(0)} ms (${load})`);
+    console.log(`  the renderer alone (paused, redrawn back to back, ${size.width}×${size.height} px, 4× MSAA): the same scene ${sceneLoop.toFixed(1)} frames/s; only the target surface, opaque (one lit ${vertices}-vertex mesh) ${surfaceLoop.toFixed(1)} frames/s`);
   } finally {
     await context.close();
     await new Promise((resolve) => server.httpServer.close(resolve));

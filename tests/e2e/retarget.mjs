@@ -208,7 +208,7 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     check(pageErrors.length === 0, `uncaught page errors: ${pageErrors.join(' | ')}`);
   });
 
-  it('retarget: KayKit clip onto the bundled human woman with her joints file, matching the CLI; an option change recomputes; errors are readable', async ({ page, browser, pageErrors }) => {
+  it('retarget: KayKit clip onto the bundled human woman with her joints file and with automatic joints, matching the CLI; an option change recomputes; errors are readable', async ({ page, browser, pageErrors }) => {
     await openJob(page);
     if ((await rtState(page)).source?.id !== 'knight') {
       await chooseCharacter(page, 'knight');
@@ -229,6 +229,27 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
       '--target', path.join(repoDir, 'data/anim/human_woman.ply'), '--target-joints', path.join(repoDir, 'data/joints/human_woman_kaykit_joints.json')], k, 'retarget-cli-knight-woman'), 'Knight → woman');
     record(browser, 'retarget Knight → woman frame 5: page vs CLI (max / height)', rel.toExponential(2));
     check(rel < 1e-4, `frame ${k} differs from the CLI's by ${rel} of the height`);
+    // The same clip with automatic joints: the Knight's curve skeleton (24 limb ends for its
+    // blocky parts) finds no partner for every limb in her, so the fit falls back to the Knight's
+    // own bones and says so; the frame equals the CLI's with --target-joints auto.
+    await page.selectOption('#rt-joints-from', 'auto');
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.fit.status !== 'fitting' && window.__meshmorph.state.retarget.jointsFrom === 'auto' && window.__meshmorph.state.retarget.joints > 0, null, { timeout: 120000 });
+    const kayFit = await rtState(page);
+    check(kayFit.fit.status === 'done' && kayFit.joints >= 15 && kayFit.fit.warnings.some((w) => /own bones/.test(w)), `Knight in the woman, automatic: ${JSON.stringify(kayFit.fit)}, ${kayFit.joints} joints`);
+    check(/own bones/.test(await page.textContent('#rt-target-info')), 'the fallback to the source\'s bones is not shown');
+    record(browser, 'retarget Knight → woman: automatic joints fitted (ms)', kayFit.fit.ms);
+    await waitRun(page);
+    await page.evaluate(() => window.__meshmorph.hooks.retargetSeek(0.5));
+    await nextFrame(page);
+    await shot(page, 'retarget-10b-woman-automatic-joints');
+    const autoFrame = await page.evaluate((i) => window.__meshmorph.hooks.retargetFrame(i), k);
+    const relAuto = compareFrame(autoFrame, cliFrame(['--source', path.join(repoDir, 'data/anim/KayKit/Knight.glb'), '--clip', 'Walking_A',
+      '--target', path.join(repoDir, 'data/anim/human_woman.ply'), '--target-joints', 'auto'], k, 'retarget-cli-knight-woman-auto'), 'Knight → woman, automatic joints');
+    record(browser, 'retarget Knight → woman (automatic joints) frame 5: page vs CLI (max / height)', relAuto.toExponential(2));
+    check(relAuto < 1e-4, `automatic joints: frame ${k} differs from the CLI's by ${relAuto} of the height`);
+    await page.selectOption('#rt-joints-from', 'file');
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.jointsFrom === 'file' && window.__meshmorph.state.retarget.joints === 18, null, { timeout: 30000 });
+    await waitRun(page);
     const plot = await page.evaluate(() => window.__meshmorph.hooks.retargetPlot());
     check(plot && plot.every(Number.isFinite), 'no bone-length plot');
     // The core's per-frame checks: self-intersecting triangle pairs (beyond the rest pose's).
@@ -408,6 +429,21 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     const withGraph = await rtState(page);
     check(withGraph.run.options.context_graph === 'on' && withGraph.graph.nodes > 50 && withGraph.graph.edges > 50, `context graph: ${JSON.stringify(withGraph.graph)}`);
     record(browser, 'retarget Fox → wolf: context graph over the target (sets / nodes / edges)', `${withGraph.graph.sets} / ${withGraph.graph.nodes} / ${withGraph.graph.edges}`);
+    // Its source side: nodes by body part and edges over the Fox, on its skinned surface at the
+    // bind pose (the core's source units), following the clip.
+    check(withGraph.graph.sourceSets >= 3 && withGraph.graph.sourceNodes > 50 && withGraph.graph.sourceEdges > 50, `source graph: ${JSON.stringify(withGraph.graph)}`);
+    const nodesAt = async (t) => {
+      await page.evaluate((time) => window.__meshmorph.hooks.retargetSeek(time), t);
+      return page.evaluate(() => window.__meshmorph.hooks.retargetSourceGraph());
+    };
+    const n0 = await nodesAt(0.1);
+    const n1 = await nodesAt(0.5);
+    const extent = (a) => Math.hypot(...[0, 1, 2].map((c) => Math.max(...a.filter((_, i) => i % 3 === c)) - Math.min(...a.filter((_, i) => i % 3 === c))));
+    const nodesMoved = Math.max(...n0.map((x, i) => Math.abs(x - n1[i])));
+    check(withGraph.graph.sourceGap < 1e-3 * extent(n0), `source graph nodes off the Fox's bind-pose surface: ${withGraph.graph.sourceGap} (extent ${extent(n0)})`);
+    check(nodesMoved > 0.01 * extent(n0), `the source graph does not follow the clip: moved ${nodesMoved} (extent ${extent(n0)})`);
+    record(browser, 'retarget Fox → wolf: source graph (parts / nodes / edges; farthest node from the bind-pose surface / extent)',
+      `${withGraph.graph.sourceSets - 1} / ${withGraph.graph.sourceNodes} / ${withGraph.graph.sourceEdges}; ${(withGraph.graph.sourceGap / extent(n0)).toExponential(2)}`);
     await nextFrame(page);
     await shot(page, 'retarget-17-context-graph');
     check(pageErrors.length === 0, `uncaught page errors: ${pageErrors.join(' | ')}`);

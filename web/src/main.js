@@ -28,6 +28,7 @@ window.__meshmorph = {
   state: shell.state,
   client,
   get frames() { return viewer.frames; },
+  viewer, // benches (tests/e2e/retarget-bench.mjs) time its render loop
   hooks: shell.hooks,
   // Where a displayed vertex is: {x, y} in client pixels and whether the camera sees it.
   vertexOnScreen: (vertex) => vertexOnScreen(viewer, vertex),

@@ -6,6 +6,7 @@
 // Each side is scaled to the same display height and stands on the same floor; its placement is
 // fixed from its rest pose, so root motion shows.
 import * as THREE from 'three';
+import { JointFollower } from '../lib/retarget-joints.js';
 import { insideTest, lastInside } from './inside.js';
 
 const sphere = new THREE.SphereGeometry(1, 14, 10);
@@ -59,10 +60,13 @@ export class RetargetView {
     this.jointMaterial = new THREE.MeshBasicMaterial({ color: 0xffd23f, depthTest: false, transparent: true });
     this.boneMaterial = new THREE.LineBasicMaterial({ color: 0x39e6a0, depthTest: false, transparent: true });
     this.pinnedMaterial = new THREE.MeshBasicMaterial({ color: 0xff4f6d, depthTest: false, transparent: true });
-    // Context-graph overlay (target coordinates): line and point sets.
-    this.graphGroup = new THREE.Group();
-    this.graphGroup.visible = false;
-    this.sides.target.root.add(this.graphGroup);
+    // Context-graph overlay: line and point sets on each side (source sets in the glTF scene's
+    // space, target sets in target coordinates).
+    this.graphGroups = { source: new THREE.Group(), target: new THREE.Group() };
+    for (const [name, g] of Object.entries(this.graphGroups)) {
+      g.visible = false;
+      this.sides[name].root.add(g);
+    }
     this.graph = [];
     this.joints = { spheres: [], lines: null, bones: [], count: 0 };
     this.dragging = -1; // the joint being dragged
@@ -224,8 +228,9 @@ export class RetargetView {
     this.viewer.requestRender();
   }
 
-  // The context graph over the target: sets {positions (#P·3), lines (#L·2, empty = points),
-  // color [r, g, b, a]} in target coordinates.
+  // The context graph: sets {positions (#P·3), lines (#L·2, empty = points), color [r, g, b, a],
+  // source (true: over the source, in the glTF scene's space at the bind pose; else over the
+  // target, in target coordinates)}.
   setGraph(sets) {
     this.clearGraph();
     for (const set of sets) {
@@ -242,7 +247,8 @@ export class RetargetView {
       }
       object.renderOrder = 2;
       object.frustumCulled = false;
-      this.graphGroup.add(object);
+      object.userData.side = set.source ? 'source' : 'target';
+      this.graphGroups[object.userData.side].add(object);
       this.graph.push(object);
     }
     this.viewer.requestRender();
@@ -258,7 +264,7 @@ export class RetargetView {
 
   clearGraph() {
     for (const o of this.graph) {
-      this.graphGroup.remove(o);
+      o.parent?.remove(o);
       o.geometry.dispose();
       o.material.dispose();
     }
@@ -267,8 +273,74 @@ export class RetargetView {
   }
 
   setGraphVisible(on) {
-    this.graphGroup.visible = on;
+    for (const g of Object.values(this.graphGroups)) g.visible = on;
     this.viewer.requestRender();
+  }
+
+  // Points on the source (the glTF scene's space at the bind pose: the core's source units) made
+  // to follow the playing clip: each keeps its offset from the mean of its k nearest skinned
+  // vertices at the bind pose (lib/retarget-joints.js JointFollower) and moves with their skinned
+  // positions. Returns {at() → Float32Array #P·3 for the pose shown, gap: the largest distance
+  // from a point to the bind-pose surface} or null (no skinned mesh).
+  sourceFollower(points, k = 4) {
+    const meshes = [];
+    this.source.scene?.traverse((o) => { if (o.isSkinnedMesh) meshes.push(o); });
+    const refs = [];
+    const rest = [];
+    const v = new THREE.Vector3();
+    for (const mesh of meshes) {
+      const p = mesh.geometry.getAttribute('position');
+      for (let i = 0; i < p.count; ++i) {
+        v.fromBufferAttribute(p, i).applyMatrix4(mesh.bindMatrix);
+        rest.push(v.x, v.y, v.z);
+        refs.push([mesh, i]);
+      }
+    }
+    if (!refs.length || !points.length) return null;
+    const follower = new JointFollower(Float32Array.from(rest), points, k);
+    const used = [...new Set(follower.near.flat())];
+    const current = new Float32Array(rest.length); // only the `used` vertices are read
+    // gap: the farthest point from the bind-pose surface (its triangles), a check that the
+    // points and this surface share units (the core's nodes lie on its source surface).
+    const triangles = [];
+    let base = 0;
+    for (const mesh of meshes) {
+      const index = mesh.geometry.index;
+      const count = mesh.geometry.getAttribute('position').count;
+      const vertex = (k) => new THREE.Vector3(rest[3 * (base + k)], rest[3 * (base + k) + 1], rest[3 * (base + k) + 2]);
+      const n = index ? index.count : count;
+      for (let t = 0; t + 2 < n; t += 3) {
+        const [a, b, c] = [t, t + 1, t + 2].map((k) => (index ? index.getX(k) : k));
+        triangles.push(new THREE.Triangle(vertex(a), vertex(b), vertex(c)));
+      }
+      base += count;
+    }
+    let gap = 0;
+    const q = new THREE.Vector3();
+    const onSurface = new THREE.Vector3();
+    for (const p of points) {
+      q.set(p[0], p[1], p[2]);
+      let best = Infinity;
+      for (const tri of triangles) best = Math.min(best, tri.closestPointToPoint(q, onSurface).distanceToSquared(q));
+      gap = Math.max(gap, Math.sqrt(best));
+    }
+    const root = this.sides.source.root;
+    const inverse = new THREE.Matrix4();
+    return {
+      gap,
+      at: () => {
+        root.updateMatrixWorld(true);
+        inverse.copy(root.matrixWorld).invert();
+        for (const u of used) {
+          const [mesh, i] = refs[u];
+          mesh.getVertexPosition(i, v).applyMatrix4(mesh.matrixWorld).applyMatrix4(inverse);
+          current[3 * u] = v.x;
+          current[3 * u + 1] = v.y;
+          current[3 * u + 2] = v.z;
+        }
+        return follower.at(current);
+      },
+    };
   }
 
   // Pinned joints (indices) drawn in their own colour.

@@ -32,7 +32,8 @@
 // Test hooks (window.__meshmorph.hooks): retargetFrame(k) → frame k's positions (array) or null,
 // retargetShown() → the target positions on screen, retargetJoints() → {names, positions},
 // retargetSeek(t), retargetJointOnScreen(j) → {x, y}, retargetCamera() → the camera position,
-// retargetPinnedDrawn() → the joints drawn as pins (red).
+// retargetPinnedDrawn() → the joints drawn as pins (red), retargetSourceGraph() → the source's graph
+// nodes as drawn (following the clip).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
 import { clipOption, filterClips, jointsFileFor, familiesOf, librarySources, libraryTargets } from '../../lib/clip-library.js';
@@ -122,7 +123,7 @@ const markup = `
     <label id="rt-link-row" hidden title="Orbiting one view moves the other the same way"><input type="checkbox" id="rt-link" checked /> Link the cameras</label>
   </div>
   <div class="row">
-    <label title="The context graph of the run (paper 002 Sec. 6; option context_graph on): the target's graph nodes and edges and its volume graph, following the frames"><input type="checkbox" id="rt-graph" disabled /> Context graph</label>
+    <label title="The context graph of the run (paper 002 Sec. 6; option context_graph on): the source's graph nodes (coloured by body part) and edges following the clip, the target's graph nodes and edges and its volume graph following the frames"><input type="checkbox" id="rt-graph" disabled /> Context graph</label>
     <span id="rt-graph-info" class="hint"></span>
   </div>
 
@@ -782,8 +783,9 @@ export const panel = {
       timeline.setPlot(plot, label, { values: crossings, color: '#ff6b8a', legend: (m) => `intersections max ${Math.round(m)}` });
     }
 
-    // The context graph of a finished run (harmonic with context_graph on), over the target; its
-    // nodes follow the frames by their nearest rest vertices.
+    // The context graph of a finished run (harmonic with context_graph on), over both sides: the
+    // target's nodes follow the frames by their nearest rest vertices, the source's the playing
+    // clip by their nearest skinned vertices (RetargetView.sourceFollower).
     async function loadGraph(session) {
       graph = null;
       view.clearGraph();
@@ -799,25 +801,39 @@ export const panel = {
         const r = await client.run('retargetGraph', { session }).promise;
         if (!surface || session !== runner.session) return;
         const sets = [];
+        let sourceGap = 0;
         r.info.sets.forEach((set, i) => {
-          if (set.source) return;
+          // The source's nodes are drawn by part (coloured points) and its edges; its plain node
+          // set would only repeat the parts.
+          if (set.source && set.name === 'source graph nodes') return;
           const positions = r.buffers[`set${i}Positions`];
           const points = [];
           for (let k = 0; k < positions.length; k += 3) points.push([positions[k], positions[k + 1], positions[k + 2]]);
-          sets.push({ positions, lines: r.buffers[`set${i}Lines`], color: set.color, name: set.name, follower: new JointFollower(surface.positions, points, 8) });
+          const follower = set.source ? view.sourceFollower(points) : new JointFollower(surface.positions, points, 8);
+          if (!follower) return;
+          if (set.source) sourceGap = Math.max(sourceGap, follower.gap);
+          sets.push({ positions, lines: r.buffers[`set${i}Lines`], color: set.color, name: set.name, source: set.source, follower });
         });
         graph = { sets };
         view.setGraph(sets);
         view.setGraphVisible($('rt-graph').checked);
-        retarget.graph = { sets: sets.length, nodes: sets.reduce((n, x) => n + x.positions.length / 3, 0), edges: sets.reduce((n, x) => n + x.lines.length / 2, 0) };
+        const count = (side, what) => sets.filter((x) => !!x.source === side && (what === 'edges') === (x.lines.length > 0))
+          .reduce((n, x) => n + (what === 'edges' ? x.lines.length / 2 : x.positions.length / 3), 0);
+        retarget.graph = { sets: sets.length, nodes: count(false, 'nodes'), edges: count(false, 'edges'),
+          sourceSets: sets.filter((x) => x.source).length, sourceNodes: count(true, 'nodes'), sourceEdges: count(true, 'edges'), sourceGap };
         $('rt-graph').disabled = false;
-        $('rt-graph-info').textContent = sets.map((x) => `${x.name}: ${x.lines.length ? `${x.lines.length / 2} edges` : `${x.positions.length / 3} nodes`}`).join(' · ');
+        const parts = sets.filter((x) => x.source && !x.lines.length).length;
+        $('rt-graph-info').textContent = `source: ${retarget.graph.sourceNodes} nodes in ${parts} parts, ${retarget.graph.sourceEdges} edges · ` +
+          sets.filter((x) => !x.source).map((x) => `${x.name}: ${x.lines.length ? `${x.lines.length / 2} edges` : `${x.positions.length / 3} nodes`}`).join(' · ');
         applyTime();
       } catch (e) {
         if (e.code !== 'Cancelled') app.showError(e);
       }
     }
-    $('rt-graph').addEventListener('change', () => view.setGraphVisible($('rt-graph').checked));
+    $('rt-graph').addEventListener('change', () => {
+      view.setGraphVisible($('rt-graph').checked);
+      applyTime();
+    });
 
     function clearRunDisplay() {
       store = null;
@@ -954,6 +970,7 @@ export const panel = {
       const t = clock.time;
       retarget.time = t;
       view.setSourceTime(t);
+      if (graph && $('rt-graph').checked) graph.sets.forEach((set, i) => { if (set.source) view.moveGraph(i, set.follower.at()); });
       if (view.played) {
         view.setPlayedTime(t - clock.start);
         timeline.setTime(t);
@@ -968,7 +985,7 @@ export const panel = {
       if (!at) return;
       view.setTargetPositions(shownBuffer);
       if (follower && joints) view.moveJoints(follower.at(shownBuffer));
-      if (graph) graph.sets.forEach((set, i) => view.moveGraph(i, set.follower.at(shownBuffer)));
+      if (graph) graph.sets.forEach((set, i) => { if (!set.source) view.moveGraph(i, set.follower.at(shownBuffer)); });
       retarget.frame = at.frame;
       retarget.shownFrames += 1;
       preview.paused = retarget.playing;
@@ -1139,6 +1156,11 @@ export const panel = {
     app.hooks.retargetJoints = () => (joints ? { names: [...joints.names], positions: joints.positions.map((p) => [...p]), bones: joints.bones.map((b) => [...b]) } : null);
     app.hooks.retargetSeek = (t) => { setPlaying(false); clock.seek(t); applyTime(); return retarget.frame; };
     app.hooks.retargetPlot = () => (plot ? Array.from(plot) : null);
+    // The source's graph nodes as drawn (the edges set, in the glTF scene's space), or null.
+    app.hooks.retargetSourceGraph = () => {
+      const i = graph ? graph.sets.findIndex((x) => x.source && x.lines.length) : -1;
+      return i >= 0 ? Array.from(view.graph[i].geometry.getAttribute('position').array) : null;
+    };
     app.hooks.retargetIntersections = () => (crossings ? Array.from(crossings) : null);
     app.hooks.retargetPreviewFrames = () => preview.frames;
     app.hooks.retargetScrubRect = () => {
