@@ -136,6 +136,8 @@ export class PlaywrightLikePage {
 
   isChecked(selector) { return this.page.evaluate((s) => document.querySelector(s).checked, selector); }
 
+  isEnabled(selector) { return this.page.evaluate((s) => !document.querySelector(s).disabled, selector); }
+
   isDisabled(selector) { return this.page.evaluate((s) => document.querySelector(s).disabled, selector); }
 
   isVisible(selector) {
