@@ -416,6 +416,22 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     const pinNames = Object.keys((await rtState(page)).pins);
     check(drawnPins.length === 2 && drawnPins.every((i) => pinNames.includes(held.names[i])), `pins drawn red after the refit: ${JSON.stringify(drawnPins)} for ${JSON.stringify(pinNames)}`);
     await shot(page, 'retarget-16-joint-stopped-at-surface');
+    // A pin the core refuses (here dropped far outside, past the drag's inside constraint, as a
+    // surface the page's inside test misjudges would): taken back with the core's message, the
+    // two pins and the joints as they were.
+    const beforeDrop = await page.evaluate(() => window.__meshmorph.hooks.retargetJoints());
+    const fitsBefore = (await rtState(page)).fit.fits;
+    const outside = beforeDrop.positions[0].map((x, c) => x + (c === 0 ? 10 : 0) * Math.max(...beforeDrop.positions.map((p) => Math.abs(p[0]))) + (c === 0 ? 1 : 0));
+    await page.evaluate(([j, p]) => window.__meshmorph.hooks.retargetDropJoint(j, p), [0, outside]);
+    await page.waitForFunction(() => /was not pinned/.test(document.querySelector('#rt-target-info').textContent) && window.__meshmorph.state.retarget.fit.status === 'done', null, { timeout: 120000 });
+    const refused = await rtState(page);
+    const afterDrop = await page.evaluate(() => window.__meshmorph.hooks.retargetJoints());
+    check(Object.keys(refused.pins).length === 2 && !(beforeDrop.names[0] in refused.pins && !pinNames.includes(beforeDrop.names[0])), `pins after the refused drop: ${JSON.stringify(Object.keys(refused.pins))}`);
+    check(JSON.stringify(afterDrop.positions) === JSON.stringify(beforeDrop.positions), 'the joints moved after a refused pin');
+    check(refused.fit.fits === fitsBefore, `a refused pin counted as a fit: ${refused.fit.fits} vs ${fitsBefore}`);
+    const refusal = await page.textContent('#rt-target-info');
+    check(/outside the target surface/.test(refusal), `the core's reason is not shown: "${refusal}"`);
+    await shot(page, 'retarget-16b-pin-refused');
     // Clear pins: fitted again without them.
     await page.click('#rt-pins-clear');
     await page.waitForFunction(() => Object.keys(window.__meshmorph.state.retarget.pins).length === 0 && window.__meshmorph.state.retarget.fit.status === 'done' && window.__meshmorph.state.retarget.joints > 0, null, { timeout: 120000 });

@@ -32,7 +32,8 @@
 // Test hooks (window.__meshmorph.hooks): retargetFrame(k) → frame k's positions (array) or null,
 // retargetShown() → the target positions on screen, retargetJoints() → {names, positions},
 // retargetSeek(t), retargetJointOnScreen(j) → {x, y}, retargetCamera() → the camera position,
-// retargetPinnedDrawn() → the joints drawn as pins (red), retargetSourceGraph() → the source's graph
+// retargetPinnedDrawn() → the joints drawn as pins (red), retargetDropJoint(j, [x, y, z]) → drops
+// joint j there as the drag would (without its inside constraint), retargetSourceGraph() → the source's graph
 // nodes as drawn (following the clip).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
@@ -630,36 +631,39 @@ export const panel = {
     }
     $('rt-edit-joints').addEventListener('change', () => setEditingJoints($('rt-edit-joints').checked));
 
-    view.attachJointDrag({
-      canDrag: () => retarget.editingJoints && Boolean(joints) && retarget.jointsFrom !== 'skin' && retarget.fit.status !== 'fitting',
-      onDrop: (j, position) => {
-        const name = joints.names[j];
-        if (retarget.jointsFrom === 'auto') {
-          const before = retarget.pins;
-          const shown = joints.positions.flat();
-          retarget.pins = { ...retarget.pins, [name]: position };
-          showPins();
-          // A pin the fit refuses (dropped outside the mesh) is taken back: the joints return to
-          // where they were and the core's message says why.
-          chooseJoints(null, true).then(() => {
-            if (retarget.fit.status !== 'error') return;
-            retarget.pins = before;
-            retarget.fit = { ...retarget.fit, status: 'done' };
-            view.moveJoints(shown);
-            showPins();
-            $('rt-target-info').textContent = `${joints.names[j]} was not pinned: ${retarget.fit.error.replace(/\.?$/, '.')} Drop it inside ${target.name}.`;
-            if (retarget.run.status !== 'done') startRun();
-            refresh();
-          });
-          return;
-        }
-        // Joints from a file: the moved joint is the new file (download it with Download joints JSON).
-        joints.positions[j] = position;
-        jointsText = JSON.stringify(Object.fromEntries(joints.names.map((n, k) => [n, joints.positions[k]])));
+    // A joint dropped at `position` (target coordinates) by the drag below (or by the test hook
+    // retargetDropJoint, which skips the drag's inside constraint to reach the core's refusal).
+    const dropJoint = (j, position) => {
+      const name = joints.names[j];
+      if (retarget.jointsFrom === 'auto') {
+        const before = retarget.pins;
+        const shown = joints.positions.flat();
         retarget.pins = { ...retarget.pins, [name]: position };
         showPins();
-        startRun();
-      },
+        // A pin the fit refuses (dropped outside the mesh) is taken back: the joints return to
+        // where they were and the core's message says why.
+        chooseJoints(null, true).then(() => {
+          if (retarget.fit.status !== 'error') return;
+          retarget.pins = before;
+          retarget.fit = { ...retarget.fit, status: 'done' };
+          view.moveJoints(shown);
+          showPins();
+          $('rt-target-info').textContent = `${joints.names[j]} was not pinned: ${retarget.fit.error.replace(/\.?$/, '.')} Drop it inside ${target.name}.`;
+          if (retarget.run.status !== 'done') startRun();
+          refresh();
+        });
+        return;
+      }
+      // Joints from a file: the moved joint is the new file (download it with Download joints JSON).
+      joints.positions[j] = position;
+      jointsText = JSON.stringify(Object.fromEntries(joints.names.map((n, k) => [n, joints.positions[k]])));
+      retarget.pins = { ...retarget.pins, [name]: position };
+      showPins();
+      startRun();
+    };
+    view.attachJointDrag({
+      canDrag: () => retarget.editingJoints && Boolean(joints) && retarget.jointsFrom !== 'skin' && retarget.fit.status !== 'fitting',
+      onDrop: dropJoint,
     });
     $('rt-pins-clear').addEventListener('click', () => {
       retarget.pins = {};
@@ -1152,6 +1156,7 @@ export const panel = {
     app.hooks.retargetPinnedDrawn = () => view.joints.spheres.flatMap((sp, j) => (sp.material === view.pinnedMaterial ? [j] : []));
     app.hooks.retargetJointOnScreen = (j) => (view.joints.spheres[j] ? view.toScreen('target', view.joints.spheres[j].position.toArray()) : null);
     app.hooks.retargetJointAt = (x, y) => view.jointAt(x, y);
+    app.hooks.retargetDropJoint = (j, position) => dropJoint(j, position);
     app.hooks.retargetCamera = () => viewer.camera.position.toArray();
     app.hooks.retargetJoints = () => (joints ? { names: [...joints.names], positions: joints.positions.map((p) => [...p]), bones: joints.bones.map((b) => [...b]) } : null);
     app.hooks.retargetSeek = (t) => { setPlaying(false); clock.seek(t); applyTime(); return retarget.frame; };
