@@ -309,6 +309,101 @@ std::string jf_join(const std::vector<std::string>& v, size_t limit = 10) {
   return s;
 }
 
+// Touching legs (step 4b). A biped whose thighs touch (human_woman) is one solid from the crotch
+// down to the knees, so its curve skeleton forks at the knees and the hips, spine and legs are
+// fitted 0.1–0.3 of the height low. Seen across the trunk just above such a fork, the solid is
+// two thighs side by side: thinner front to back between them than through each. Walking up the
+// trunk while that groove holds (centre thickness < groove_ratio × the thinner side, the sides at
+// the legs' half separation just below the fork) finds the crotch; the fork is moved there (not
+// past another branch) and each leg continued straight up to it, side by side at that separation.
+// feet/head: target leaf nodes. Returns the old → new node index map, or empty when nothing changed.
+std::vector<int> jf_split_touching_legs(CurveSkeleton* T, const JfTree& tt, const std::array<int, 2>& feet, int head,
+                                        double groove_ratio) {
+  const int fork_t = tt.median(feet[0], feet[1], head);
+  const auto adj = T->adjacency();
+  if (adj[fork_t].size() != 3) return {};
+  // The legs' nodes just below the old fork, and their half separation across the trunk.
+  const JfPath trunk = jf_path(tt, fork_t, head);
+  if (trunk.nodes.size() < 3) return {};
+  std::array<int, 2> below{};
+  for (int i = 0; i < 2; ++i) {
+    const JfPath leg = jf_path(tt, feet[i], fork_t);
+    if (leg.nodes.size() < 2) return {};
+    below[i] = leg.nodes[leg.nodes.size() - 2];
+  }
+  const Eigen::Vector3d up = (tt.pos(trunk.nodes[std::min<size_t>(3, trunk.nodes.size() - 1)]) - tt.pos(fork_t)).normalized();
+  Eigen::Vector3d half = 0.5 * (tt.pos(below[0]) - tt.pos(below[1]));
+  half -= half.dot(up) * up;
+  const Eigen::Vector3d depth_dir = up.cross(half).normalized();
+  if (!up.allFinite() || !depth_dir.allFinite() || half.norm() <= 0) return {};
+  // Front-to-back thickness of the solid through p (0 when p is outside).
+  const VoxelSolid& solid = T->volume;
+  const double step = 0.5 * solid.grid.cell;
+  // Extent of the solid from p to its front (+depth_dir) and to its back (0 when p is outside).
+  auto extents = [&](const Eigen::Vector3d& p) {
+    std::array<double, 2> e{0, 0};
+    if (!solid.contains(p)) return e;
+    for (int side = 0; side < 2; ++side) {
+      const double sign = side == 0 ? 1.0 : -1.0;
+      for (int k = 1; k < 4096 && solid.contains(p + sign * k * step * depth_dir); ++k) e[side] += step;
+    }
+    return e;
+  };
+  // A groove between the legs: thinner front to back at the centre than through either leg.
+  auto grooved = [&](const Eigen::Vector3d& c) {
+    const auto m = extents(c), a = extents(c + half), b = extents(c - half);
+    return m[0] + m[1] < groove_ratio * std::min(a[0] + a[1], b[0] + b[1]);
+  };
+  // Up the trunk from the old fork while the groove holds, not past another branch.
+  int k = 0;
+  while (k + 1 < int(trunk.nodes.size()) && adj[trunk.nodes[k + 1]].size() == 2) {
+    if (!grooved(tt.pos(trunk.nodes[k + 1]))) break;
+    ++k;
+  }
+  if (k == 0 || k + 1 >= int(trunk.nodes.size())) return {};
+  // Rebuild: drop trunk nodes 0..k−1, add one chain per leg from its node below to trunk node k.
+  const int n = T->size();
+  std::vector<uint8_t> drop(n, 0);
+  for (int i = 0; i < k; ++i) drop[trunk.nodes[i]] = 1;
+  std::vector<int> remap(n, -1);
+  std::vector<Eigen::Vector3d> pos;
+  std::vector<double> radius;
+  for (int v = 0; v < n; ++v)
+    if (!drop[v]) remap[v] = int(pos.size()), pos.push_back(T->nodes.row(v).transpose()), radius.push_back(T->radius[v]);
+  std::vector<std::vector<int>> nb(pos.size());
+  auto link = [&](int a, int b) { nb[a].push_back(b), nb[b].push_back(a); };
+  for (int v = 0; v < n; ++v)
+    if (T->parent[v] >= 0 && !drop[v] && !drop[T->parent[v]]) link(remap[v], remap[T->parent[v]]);
+  for (int i = 0; i < 2; ++i) {
+    int prev = remap[below[i]];
+    const double sign = i == 0 ? 1.0 : -1.0;
+    for (int j = 0; j < k; ++j) {
+      const int id = int(pos.size());
+      pos.push_back(tt.pos(trunk.nodes[j]) + sign * half);
+      radius.push_back(T->radius[below[i]]);
+      nb.emplace_back();
+      link(prev, id);
+      prev = id;
+    }
+    link(prev, remap[trunk.nodes[k]]);
+  }
+  const int m = int(pos.size());
+  const int root = remap[T->root] >= 0 ? remap[T->root] : remap[trunk.nodes[k]];
+  std::vector<int> parent(m, -2);
+  parent[root] = -1;
+  std::vector<int> queue = {root};
+  for (size_t q = 0; q < queue.size(); ++q)
+    for (int w : nb[queue[q]])
+      if (parent[w] == -2) parent[w] = queue[q], queue.push_back(w);
+  if (int(queue.size()) != m) return {};  // not a tree any more: leave the skeleton as it was
+  T->nodes.resize(m, 3);
+  T->radius.resize(m);
+  for (int i = 0; i < m; ++i) T->nodes.row(i) = pos[i].transpose(), T->radius[i] = radius[i];
+  T->parent = parent;
+  T->root = root;
+  return remap;
+}
+
 // Steps 2–6 on the skeletons in r (the source's tree chosen by the caller). `lost_limbs`: set when
 // the fit is refused because a source limb has no partner in the target (the case where the
 // source's own bones may still fit, SourceSkeleton::Auto).
@@ -324,7 +419,7 @@ struct JfInputs {
   const Progress& progress;
 };
 
-JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool* lost_limbs) {
+JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool source_is_curve, bool* lost_limbs) {
   const Eigen::MatrixXd &Vs = in.Vs, &Vt = in.Vt;
   const Eigen::MatrixXi &Fs = in.Fs, &Ft = in.Ft;
   const JointSet& source_joints = in.source_joints;
@@ -343,7 +438,7 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool* l
   };
   const CurveSkeleton& SS = r.source_skeleton;
   const CurveSkeleton& TS = r.target_skeleton;
-  const JfTree st(SS), tt(TS);
+  JfTree st(SS), tt(TS);  // rebuilt when touching legs are split (step 4b)
   const std::vector<int> s_leaves = SS.leaves(), t_leaves = TS.leaves();
   if (s_leaves.size() < 2 || t_leaves.size() < 2)
     return fail(StatusCode::InvalidMesh, std::string("the ") + (s_leaves.size() < 2 ? "source" : "target") +
@@ -444,7 +539,7 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool* l
 
   // Closest points of the used source joints on the whole source skeleton, to find which limb
   // ends carry joints (an edge (u, parent u) whose subtree below holds a single leaf is that leaf's).
-  const int ns = SS.size();
+  int ns = SS.size();  // changes when touching legs are split (step 4b)
   std::vector<int> leaves_below(ns, 0), only_leaf(ns, -1);
   {
     std::vector<int> order(ns);
@@ -522,6 +617,41 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool* l
   }
   if (match.pairs.size() < 2)
     return fail(StatusCode::InvalidArgument, "fewer than 2 limb ends of the target match the source's: place the joints with markers");
+
+  // 4b. Touching legs: a biped whose skeleton forks below its crotch. Both curve skeletons are
+  // cut alike (a self-fit stays exact); the source's own bones have a real hip joint.
+  if (r.source_ground == 2 && r.target_ground == 2 && opt.touching_legs_groove > 0) {
+    std::vector<std::pair<int, int>> feet;
+    int top = -1;
+    double top_height = -std::numeric_limits<double>::infinity();
+    for (int i = 0; i < int(match.pairs.size()); ++i) {
+      const auto& pr = match.pairs[i];
+      const double ht = ft.height(R * tt.pos(pr.second));
+      if (fs.height(st.pos(pr.first)) < opt.ground_band && ht < opt.ground_band) feet.push_back(pr);
+      if (ht > top_height) top_height = ht, top = i;
+    }
+    if (feet.size() == 2 && top >= 0) {
+      const std::pair<int, int> head = match.pairs[top];
+      const std::vector<int> remap_t = jf_split_touching_legs(&r.target_skeleton, tt, {feet[0].second, feet[1].second},
+                                                              head.second, opt.touching_legs_groove);
+      const std::vector<int> remap_s =
+          source_is_curve ? jf_split_touching_legs(&r.source_skeleton, st, {feet[0].first, feet[1].first}, head.first,
+                                                   opt.touching_legs_groove)
+                          : std::vector<int>{};
+      if (!remap_t.empty()) {
+        tt = JfTree(TS);
+        for (auto& pr : match.pairs) pr.second = remap_t[pr.second];
+        r.warnings.push_back("the target's thighs touch (its skeleton forked below the crotch): the legs were split "
+                             "up to the crotch");
+      }
+      if (!remap_s.empty()) {
+        st = JfTree(SS);
+        ns = SS.size();
+        for (auto& pr : match.pairs) pr.first = remap_s[pr.first];
+      }
+      r.limb_ends = match.pairs;
+    }
+  }
 
   // 5. Paths between matched ends on both sides, and their branch points.
   const int nm = int(match.pairs.size());
@@ -749,14 +879,14 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
   JointFitResult voxel;
   if (opt.source_skeleton != SourceSkeleton::Bones) {
     bool lost = false;
-    voxel = jf_fit_on_skeletons(r, in, &lost);
+    voxel = jf_fit_on_skeletons(r, in, true, &lost);
     voxel.source_tree = SourceSkeleton::Voxel;
     if (voxel.status.ok() || opt.source_skeleton == SourceSkeleton::Voxel || !lost) return voxel;
   }
   const size_t voxel_ends = r.source_skeleton.leaves().size();
   r.source_skeleton = jf_bone_skeleton(r.source_skeleton, source_joints, used, bvh_s);
   if (!r.source_skeleton.status.ok()) return fail(r.source_skeleton.status.code, r.source_skeleton.status.message);
-  JointFitResult bones = jf_fit_on_skeletons(r, in, nullptr);
+  JointFitResult bones = jf_fit_on_skeletons(r, in, false, nullptr);
   bones.source_tree = SourceSkeleton::Bones;
   if (opt.source_skeleton == SourceSkeleton::Bones) return bones;
   if (!bones.status.ok()) {

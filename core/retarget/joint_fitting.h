@@ -44,9 +44,8 @@ namespace mm {
 // Voxel: both sides are cut alike, so proportions along branches compare (self-fits ≤ 1% of the
 // height). Bones fits sources whose curve skeleton has far more limb ends than their rig
 // (KayKit's blocky parts: 24 ends for 5 limbs), which Voxel refuses as a topology mismatch;
-// measured KayKit Knight → human_woman: 13% of the height from the hand-placed joints (the
-// woman's legs touch, so her skeleton forks low). Measured by the joints' vertical span instead:
-// 15% for Bones, 20% for Voxel with the topology check off. Bones as the only mode is worse where
+// measured KayKit Knight → human_woman: 6.9% of the height from the hand-placed joints (13% before
+// the back points stopped at half the limb and her touching legs were split). Bones as the only mode is worse where
 // Voxel fits (Knight self-fit 3%, Fox → wolf0 12% vs 8.7%), hence Auto.
 enum class SourceSkeleton {
   Auto,    // Voxel; where a source limb finds no partner in the target, Bones (with a warning)
@@ -68,6 +67,9 @@ struct JointFitOptions {
   double back_limb_fraction = 0.5; // but at most this × the limb's length to its first branch point
   double ground_band = 0.12;      // limb ends below this × height count as standing on the ground
   double inside_tolerance = 0.01; // a joint within this × bbox diagonal outside the surface counts as inside
+  double touching_legs_groove = 0.95;// biped target: trunk nodes above the leg fork whose front-to-back thickness
+                                   // between the legs is below this × through each leg are thighs that touch;
+                                   // the legs are split up to the first node without that groove (0 = off)
   int marker_reach = 3;           // markers move unpinned joints up to this many bones away (0 = only pin)
   bool check_topology = true;     // refuse a mismatch (step 4); false = fit whatever matches
 };
