@@ -7,6 +7,11 @@
 #include "bench.h"
 #include "io/asset.h"
 #include "app/retarget_job.h"
+#include "character/animated_character.h"
+#include "io/gltf_animation.h"
+#include "mesh/midpoint_subdivide.h"
+#include "retarget/curve_skeleton.h"
+#include "retarget/joint_fitting.h"
 
 namespace {
 
@@ -49,6 +54,36 @@ void bench_retarget(mm::bench::Context& ctx) {
   }
 }
 
+// Automatic joints (issue 14): the curve skeleton alone, and a whole fit (two skeletons, axes,
+// matching, placement) of CesiumMan's skeleton in human_woman, at ~7k vertices and with the
+// surfaces split 1 → 4 at edge midpoints (armadillo 58k; the woman twice, 110k).
+void bench_joints(mm::bench::Context& ctx) {
+  const std::string wp = ctx.find_data("anim/human_woman.ply"), ap = ctx.find_data("edit/armadillo.ply"),
+                    cp = ctx.find_data("anim/CesiumMan/CesiumMan.glb");
+  if (wp.empty() || ap.empty() || cp.empty()) return;
+  const mm::io::LoadResult woman = mm::io::load_asset(wp), arm = mm::io::load_asset(ap), cesium = mm::io::load_asset(cp);
+  if (!woman.status.ok() || !arm.status.ok() || !cesium.status.ok()) return;
+  const int reps = ctx.quick ? 1 : 3;
+  const mm::Mesh w{woman.asset.V_raw, woman.asset.F_raw};
+  const mm::Mesh a = mm::midpoint_subdivide(mm::Mesh{arm.asset.V_raw, arm.asset.F_raw});
+  for (const auto& [name, m] : {std::pair<const char*, const mm::Mesh*>{"human_woman", &w}, {"armadillo split 1→4", &a}}) {
+    mm::Status st;
+    const double ms = ctx.time_ms([&] { st = mm::curve_skeleton(m->V, m->F).status; }, reps);
+    if (st.ok()) ctx.add({"joints", name, static_cast<int>(m->V.rows()), "curve skeleton", ms, "issue 14: fit ≤ 1 s at 50k", ""});
+  }
+  mm::io::CharacterResult c = mm::io::animated_character(cesium.asset, {});
+  if (!c.status.ok()) return;
+  const mm::JointSet joints = mm::character_joints(c.character);
+  const mm::Mesh w4 = mm::midpoint_subdivide(mm::midpoint_subdivide(w));
+  for (const auto& [name, m] : {std::pair<const char*, const mm::Mesh*>{"CesiumMan->human_woman", &w},
+                                {"CesiumMan->human_woman split 1→16", &w4}}) {
+    mm::Status st;
+    const double ms = ctx.time_ms([&] { st = mm::fit_joints(c.character.V_rest, c.character.F, joints, m->V, m->F).status; }, reps);
+    if (st.ok()) ctx.add({"joints", name, static_cast<int>(m->V.rows()), "fit (both skeletons, match, place)", ms, "issue 14: ≤ 1 s at 50k", ""});
+  }
+}
+
 }  // namespace
 
 MM_BENCH(retarget, bench_retarget);
+MM_BENCH(joints, bench_joints);

@@ -599,26 +599,3 @@ TEST(JointsJob, JsonReadsBackAndDrivesRetarget) {
   EXPECT_NE(bad.status.message.find("chin"), std::string::npos);
 }
 
-TEST(CurveSkeleton, TimingAt7kAnd50kVertices) {
-  // Not a speed test (bench/ measures speed): prints the extraction time for the report.
-  const mm::io::LoadResult t = mm::io::load_asset(mm::test::data_path("anim/human_woman.ply"));
-  const mm::io::LoadResult arm = mm::io::load_asset(mm::test::data_path("edit/armadillo.ply"));
-  ASSERT_TRUE(t.status.ok() && arm.status.ok());
-  // ~50k: the armadillo (14.6k) with every triangle split in 4 at its edge midpoints (58k).
-  const mm::Mesh fine = mm::midpoint_subdivide(mm::Mesh{arm.asset.V_raw, arm.asset.F_raw});
-  const Eigen::MatrixXd& Vb = fine.V;
-  const Eigen::MatrixXi& Fb = fine.F;
-  for (int pass = 0; pass < 2; ++pass) {
-    const Eigen::MatrixXd& X = pass ? Vb : t.asset.V_raw;
-    const Eigen::MatrixXi& Y = pass ? Fb : t.asset.F_raw;
-    double best = 1e9;
-    for (int rep = 0; rep < 3; ++rep) {
-      const auto t0 = std::chrono::steady_clock::now();
-      const mm::CurveSkeleton s = mm::curve_skeleton(X, Y);
-      best = std::min(best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-      ASSERT_TRUE(s.status.ok());
-    }
-    std::cout << "[ curve skeleton ] " << X.rows() << " vertices: " << best << " ms (best of 3)\n";
-    RecordProperty(pass ? "ms_50k" : "ms_7k", std::to_string(best));
-  }
-}
