@@ -66,7 +66,9 @@ void bench_joints(mm::bench::Context& ctx) {
   const int reps = ctx.quick ? 1 : 3;
   const mm::Mesh w{woman.asset.V_raw, woman.asset.F_raw};
   const mm::Mesh a = mm::midpoint_subdivide(mm::Mesh{arm.asset.V_raw, arm.asset.F_raw});
-  for (const auto& [name, m] : {std::pair<const char*, const mm::Mesh*>{"human_woman", &w}, {"armadillo split 1→4", &a}}) {
+  for (const auto& item : {std::pair<const char*, const mm::Mesh*>{"human_woman", &w}, {"armadillo split 1→4", &a}}) {
+    const char* name = item.first;
+    const mm::Mesh* m = item.second;  // not a structured binding: lambdas capture it (C++17)
     mm::Status st;
     const double ms = ctx.time_ms([&] { st = mm::curve_skeleton(m->V, m->F).status; }, reps);
     if (st.ok()) ctx.add({"joints", name, static_cast<int>(m->V.rows()), "curve skeleton", ms, "issue 14: fit ≤ 1 s at 50k", ""});
@@ -75,8 +77,10 @@ void bench_joints(mm::bench::Context& ctx) {
   if (!c.status.ok()) return;
   const mm::JointSet joints = mm::character_joints(c.character);
   const mm::Mesh w4 = mm::midpoint_subdivide(mm::midpoint_subdivide(w));
-  for (const auto& [name, m] : {std::pair<const char*, const mm::Mesh*>{"CesiumMan->human_woman", &w},
-                                {"CesiumMan->human_woman split 1→16", &w4}}) {
+  for (const auto& item : {std::pair<const char*, const mm::Mesh*>{"CesiumMan->human_woman", &w},
+                           {"CesiumMan->human_woman split 1→16", &w4}}) {
+    const char* name = item.first;
+    const mm::Mesh* m = item.second;
     mm::Status st;
     const double ms = ctx.time_ms([&] { st = mm::fit_joints(c.character.V_rest, c.character.F, joints, m->V, m->F).status; }, reps);
     if (st.ok()) ctx.add({"joints", name, static_cast<int>(m->V.rows()), "fit (both skeletons, match, place)", ms, "issue 14: ≤ 1 s at 50k", ""});
