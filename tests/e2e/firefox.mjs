@@ -110,6 +110,11 @@ export class PlaywrightLikePage {
 
   // The focus and blur events are dispatched as well: under Xvfb the window does not always have
   // the focus, and then focus()/blur() fire nothing (lil-gui's finish-change listens to blur).
+  async press(selector, key) {
+    await this.page.focus(selector);
+    await this.page.keyboard.press(key);
+  }
+
   fill(selector, value) {
     return this.page.evaluate((s, v) => {
       const input = document.querySelector(s);

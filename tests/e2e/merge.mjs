@@ -130,6 +130,21 @@ export function registerMergeTests(it, { check, shot, nextFrame, waitIdle, canva
     check(stats.foreground > 0.04, `the pair is not drawn (${(stats.foreground * 100).toFixed(1)}% foreground)`);
     check((await page.textContent('#mg-steps .current')).includes('Click a point on the target'), 'the current step does not name the next action');
     await shot(page, 'merge-1-pair');
+    // The widths are sliders (× a diagonal) over the range that matters; a typed larger value
+    // widens the slider instead of being cut to it.
+    const sliders = await page.evaluate(() => ['roi_width', 'transition_target_width', 'transition_source_width']
+      .map((n) => Boolean(document.querySelector(`#opt-${n}`)?.closest('.lil-controller')?.querySelector('.lil-slider'))));
+    check(sliders.every(Boolean), `width sliders: ${JSON.stringify(sliders)}`);
+    await page.click('#mg-options .lil-gui.options > .lil-title');
+    await page.fill('#opt-roi_width', '2.5');
+    await page.press('#opt-roi_width', 'Enter');
+    await page.click('section.merge h2');
+    const typed = await page.inputValue('#opt-roi_width');
+    check(Number(typed) === 2.5, `roi_width typed 2.5, kept ${typed}`);
+    await page.fill('#opt-roi_width', '0.25');
+    await page.press('#opt-roi_width', 'Enter');
+    await page.click('section.merge h2');
+    await page.click('#mg-options .lil-gui.options > .lil-title');
 
     // Keys by clicking, as data/specs/merge-camelhead-horse.json has them.
     const { target_keys: tk, source_keys: sk } = exampleSpec.pairs[0];

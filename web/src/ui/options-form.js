@@ -27,9 +27,13 @@ function wantsSlider(option) {
 }
 
 export class OptionsForm {
-  // schema: the optionSchema array; title: the panel's title.
-  constructor(schema, { title = 'Options' } = {}) {
+  // schema: the optionSchema array; title: the panel's title; sliders: {name: max} — a slider up
+  // to `max` for an option the schema leaves unbounded above (widths in units of a diagonal,
+  // where a few units already cover the whole mesh); a larger value (typed, or from a spec)
+  // widens it.
+  constructor(schema, { title = 'Options', sliders = {} } = {}) {
     this.schema = schema;
+    this.sliders = sliders;
     this.values_ = Object.fromEntries(schema.map((o) => [o.name, o.default ?? (o.kind === 'text' ? '' : 0)]));
     this.gui = new GUI({ autoPlace: false, title, closeFolders: true, width: undefined });
     this.gui.domElement.classList.add('options');
@@ -63,9 +67,19 @@ export class OptionsForm {
     }
     if (kind === 'integer' || kind === 'number') {
       object[name] = Number(object[name]);
-      const slider = wantsSlider(option);
+      const soft = Number.isFinite(option.max) ? undefined : this.sliders[name];
+      const slider = soft !== undefined || wantsSlider(option);
       const c = this.gui.add(object, name);
       if (Number.isFinite(option.min)) c.min(option.min);
+      if (soft !== undefined) {
+        c.max(soft);
+        // A typed value above the slider widens it instead of being cut to it (lil-gui clamps
+        // typed values to [min, max] through _clamp; lil-gui is pinned in package.json).
+        const lo = Number.isFinite(option.min) ? option.min : -Infinity;
+        c._clamp = (v) => Math.max(lo, v);
+        c.onChange((v) => { if (v > c._max) c.max(v); });
+        return c;
+      }
       // Without a slider the maximum is enforced here (lil-gui draws a slider as soon as both
       // bounds are set).
       if (slider) c.max(option.max);

@@ -1059,7 +1059,10 @@ export const panel = {
     app.on('ready', async () => {
       try {
         const schema = (await client.run('optionSchema', { job: 'merge' }).promise).info;
-        form = new OptionsForm(schema.options.filter((o) => o.name !== 'mode'), { title: 'Options' });
+        // Widths (× a diagonal) on sliders over the range that matters; a spec's larger value widens it.
+        form = new OptionsForm(schema.options.filter((o) => o.name !== 'mode'), {
+          title: 'Options', sliders: { roi_width: 1, transition_target_width: 0.5, transition_source_width: 0.5 },
+        });
         $('mg-options').append(form.element);
       } catch (e) {
         app.showError(e);
