@@ -345,9 +345,9 @@ export function registerMergeTests(it, { check, shot, nextFrame, waitIdle, canva
     }
     // The example's horse is cut at the neck: Undo cut gives the closed horse back.
     await page.click('#mg-cut summary');
-    while ((await mergeState(page)).target.cuts.length) {
-      await page.click('#mg-cut-undo');
-      await page.waitForFunction((n) => window.__meshmorph.state.merge.target.cuts.length < n, (await mergeState(page)).target.cuts.length, { timeout: 60000 });
+    for (let n = (await mergeState(page)).target.cuts.length; n > 0; n = (await mergeState(page)).target.cuts.length) {
+      await page.click('#mg-cut-undo'); // n is read before the click: Firefox's click can return after the undo landed
+      await page.waitForFunction((k) => window.__meshmorph.state.merge.target.cuts.length < k, n, { timeout: 60000 });
       await waitIdle(page);
     }
     m = await mergeState(page);

@@ -485,7 +485,7 @@ export const panel = {
             return refresh();
           }
           stopRun('new joints');
-          const fitted = await fitJoints();
+          const fitted = await fitJoints({ quiet: keepShown });
           if (!fitted) return refresh(); // superseded, cancelled or failed (the error is shown)
           const { names, parents, warnings, json } = fitted.info;
           const p = fitted.buffers.positions;
@@ -562,7 +562,8 @@ export const panel = {
     // (dragged joints) hold named joints where the person put them. Latest fit only.
 
     let fitRequest = null;
-    async function fitJoints() {
+    // quiet: no error banner (a pin's refit: the drop handler takes the pin back and says why).
+    async function fitJoints({ quiet = false } = {}) {
       if (fitRequest) client.cancel(fitRequest.id);
       const pins = retarget.pins;
       const markersJson = Object.keys(pins).length ? JSON.stringify(pins) : '';
@@ -583,7 +584,7 @@ export const panel = {
         if (fitRequest !== req || e.code === 'Cancelled') return null;
         retarget.fit = { ...retarget.fit, status: 'error', error: e.message };
         runText('');
-        app.showError(e);
+        if (!quiet) app.showError(e);
         $('rt-target-info').textContent = `${target.name}: the automatic joints failed (${e.message}). Choose "from a joints file", or pick a clip of another character.`;
         return null;
       } finally {
