@@ -336,7 +336,6 @@ std::vector<int> jf_split_touching_legs(CurveSkeleton* T, const JfTree& tt, cons
   half -= half.dot(up) * up;
   const Eigen::Vector3d depth_dir = up.cross(half).normalized();
   if (!up.allFinite() || !depth_dir.allFinite() || half.norm() <= 0) return {};
-  // Front-to-back thickness of the solid through p (0 when p is outside).
   const VoxelSolid& solid = T->volume;
   const double step = 0.5 * solid.grid.cell;
   // Extent of the solid from p to its front (+depth_dir) and to its back (0 when p is outside).
@@ -409,10 +408,10 @@ std::vector<int> jf_split_touching_legs(CurveSkeleton* T, const JfTree& tt, cons
 // source's own bones may still fit, SourceSkeleton::Auto).
 struct JfInputs {
   const Eigen::MatrixXd &Vs, &Vt;
-  const Eigen::MatrixXi &Fs, &Ft;
+  const Eigen::MatrixXi& Ft;
   const JointSet& source_joints;
   const std::vector<int>& used;
-  const TriangleBvh &bvh_s, &bvh_t;
+  const TriangleBvh& bvh_t;
   double tol_t;
   const std::vector<JointMarker>& markers;
   const JointFitOptions& opt;
@@ -421,15 +420,13 @@ struct JfInputs {
 
 JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool source_is_curve, bool* lost_limbs) {
   const Eigen::MatrixXd &Vs = in.Vs, &Vt = in.Vt;
-  const Eigen::MatrixXi &Fs = in.Fs, &Ft = in.Ft;
+  const Eigen::MatrixXi& Ft = in.Ft;
   const JointSet& source_joints = in.source_joints;
   const std::vector<int>& used = in.used;
   const TriangleBvh& bvh_t = in.bvh_t;
   const std::vector<JointMarker>& markers = in.markers;
   const JointFitOptions& opt = in.opt;
   const Progress& progress = in.progress;
-  (void)Fs;
-  (void)Ft;
   const double tol_t = in.tol_t;
   auto inside_t = [&](const Eigen::Vector3d& p) { return bvh_t.closest_point(p).sq_distance <= tol_t * tol_t || bvh_t.inside(p); };
   auto fail = [&](StatusCode c, const std::string& m) {
@@ -873,7 +870,7 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
     else r.skipped.push_back(source_joints.names[j]);
   }
   if (used.size() < 2) return fail(StatusCode::InvalidArgument, "fewer than 2 source joints lie inside the source surface");
-  const JfInputs in{Vs, Vt, Fs, Ft, source_joints, used, bvh_s, bvh_t, tol_t, markers, opt, progress};
+  const JfInputs in{Vs, Vt, Ft, source_joints, used, bvh_t, tol_t, markers, opt, progress};
   // The source's curve skeleton first (Voxel, Auto); Auto falls back to the source's own bones
   // when a source limb finds no partner (blocky, many-part sources: KayKit's 24 limb ends).
   JointFitResult voxel;

@@ -277,44 +277,51 @@ export class RetargetView {
     this.viewer.requestRender();
   }
 
+  // The source's skinned vertices at the bind pose (bindMatrix · v: the glTF scene's space) and
+  // their triangles, built once per source scene (every overlay set's follower uses them).
+  sourceBindPose() {
+    const scene = this.source.scene;
+    if (this.bindPose?.scene === scene) return this.bindPose;
+    const meshes = [];
+    scene?.traverse((o) => { if (o.isSkinnedMesh) meshes.push(o); });
+    const refs = [];
+    const rest = [];
+    const triangles = [];
+    const v = new THREE.Vector3();
+    for (const mesh of meshes) {
+      const p = mesh.geometry.getAttribute('position');
+      const base = refs.length;
+      for (let i = 0; i < p.count; ++i) {
+        v.fromBufferAttribute(p, i).applyMatrix4(mesh.bindMatrix);
+        rest.push(v.x, v.y, v.z);
+        refs.push([mesh, i]);
+      }
+      const index = mesh.geometry.index;
+      const vertex = (q) => new THREE.Vector3(rest[3 * (base + q)], rest[3 * (base + q) + 1], rest[3 * (base + q) + 2]);
+      const n = index ? index.count : p.count;
+      for (let t = 0; t + 2 < n; t += 3) {
+        const [a, b, c] = [t, t + 1, t + 2].map((q) => (index ? index.getX(q) : q));
+        triangles.push(new THREE.Triangle(vertex(a), vertex(b), vertex(c)));
+      }
+    }
+    this.bindPose = { scene, meshes, refs, rest: Float32Array.from(rest), triangles };
+    return this.bindPose;
+  }
+
   // Points on the source (the glTF scene's space at the bind pose: the core's source units) made
   // to follow the playing clip: each keeps its offset from the mean of its k nearest skinned
   // vertices at the bind pose (lib/retarget-joints.js JointFollower) and moves with their skinned
   // positions. Returns {at() → Float32Array #P·3 for the pose shown, gap: the largest distance
   // from a point to the bind-pose surface} or null (no skinned mesh).
   sourceFollower(points, k = 4) {
-    const meshes = [];
-    this.source.scene?.traverse((o) => { if (o.isSkinnedMesh) meshes.push(o); });
-    const refs = [];
-    const rest = [];
+    const { refs, rest, triangles } = this.sourceBindPose();
     const v = new THREE.Vector3();
-    for (const mesh of meshes) {
-      const p = mesh.geometry.getAttribute('position');
-      for (let i = 0; i < p.count; ++i) {
-        v.fromBufferAttribute(p, i).applyMatrix4(mesh.bindMatrix);
-        rest.push(v.x, v.y, v.z);
-        refs.push([mesh, i]);
-      }
-    }
     if (!refs.length || !points.length) return null;
-    const follower = new JointFollower(Float32Array.from(rest), points, k);
+    const follower = new JointFollower(rest, points, k);
     const used = [...new Set(follower.near.flat())];
     const current = new Float32Array(rest.length); // only the `used` vertices are read
     // gap: the farthest point from the bind-pose surface (its triangles), a check that the
     // points and this surface share units (the core's nodes lie on its source surface).
-    const triangles = [];
-    let base = 0;
-    for (const mesh of meshes) {
-      const index = mesh.geometry.index;
-      const count = mesh.geometry.getAttribute('position').count;
-      const vertex = (k) => new THREE.Vector3(rest[3 * (base + k)], rest[3 * (base + k) + 1], rest[3 * (base + k) + 2]);
-      const n = index ? index.count : count;
-      for (let t = 0; t + 2 < n; t += 3) {
-        const [a, b, c] = [t, t + 1, t + 2].map((k) => (index ? index.getX(k) : k));
-        triangles.push(new THREE.Triangle(vertex(a), vertex(b), vertex(c)));
-      }
-      base += count;
-    }
     let gap = 0;
     const q = new THREE.Vector3();
     const onSurface = new THREE.Vector3();
