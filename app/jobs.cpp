@@ -13,6 +13,7 @@ const std::vector<JobSchema>& job_schemas() {
       {"edit", edit_options().json(), edit_options().help()},
       {"merge", merge_options().json(), merge_options().help()},
       {"transfer", transfer_options().json(), transfer_options().help()},
+      {"transfer-parts", transfer_part_options().json(), transfer_part_options().help()},
       {"retarget", retarget_options().json(), retarget_options().help()},
       {"joints", joints_options().json(), joints_options().help()},
   };

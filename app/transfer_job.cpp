@@ -46,7 +46,7 @@ const OptionSchema<PoseTransferOptions>& transfer_options() {
 const OptionSchema<PartTransferOptions>& transfer_part_options() {
   using O = PartTransferOptions;
   static const OptionSchema<O> schema = [] {
-    OptionSchema<O> s("transfer parts", "hierarchical part transfer (paper 000 Sec. 4.3), with --parts");
+    OptionSchema<O> s("transfer-parts", "hierarchical part transfer (paper 000 Sec. 4.3), with --parts");
     s.integer("part_cage_vertices", [](O& o) -> int& { return o.part_cage_vertices; }, 8, 100000,
               "size of each part's automatic cage");
     s.integer("min_part_vertices", [](O& o) -> int& { return o.min_part_vertices; }, 0, 10000000,

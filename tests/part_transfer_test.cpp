@@ -354,6 +354,17 @@ TEST(PartTransferJob, NestedPartsFromAFile) {
   EXPECT_EQ(r.parts.reports[1].level, 3);
   EXPECT_EQ(r.parts.reports[1].name, "paw");
   std::printf("%s", app::transfer_summary(r, PoseTransferOptions{}).c_str());
+  // Golden shared by the native and wasm runs (issue 16): this two-level (three with the paw)
+  // result, every 50th vertex. Tolerance 1e-2 mesh units (lion bbox diagonal 1.13): measured
+  // wasm vs native 5.3e-3. Level 1 differs by 7e-4 between the targets (the eigensolver's last
+  // bits: SSE natively, none in wasm; libm), and each part's own Transfer I amplifies that: on a
+  // limb (nearly a cylinder, with near-degenerate eigenpairs) the coupled bases stop at their
+  // step cap before they settle, so the paw's frame rotation comes out 21.6° natively and 24.3°
+  // in wasm (docs/transfer.md). A part skipped or glued without its rotation moves its
+  // vertices by 0.03 or more.
+  Eigen::MatrixXd sample((r.parts.V.rows() + 49) / 50, 3);
+  for (int i = 0; i < sample.rows(); ++i) sample.row(i) = r.parts.V.row(50 * i);
+  test::expect_golden("transfer_parts_lion05_leg", sample, 1e-2);
   PartsSpec back;
   ASSERT_TRUE(io::read_parts(parts_out, &back).ok());
   ASSERT_EQ(back.parts.size(), 1u);

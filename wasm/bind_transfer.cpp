@@ -14,11 +14,13 @@
 //   partTransfer(refPositions, refIndices, srcPositions, srcIndices, landmarks, parts, options?,
 //                partOptions?, progress?)   hierarchical part transfer (paper 000 Sec. 4.3, issue 16)
 //     parts: "auto" (proposed parts) or the text of a part file (core/io/parts_file.h)
-//     options: the transfer schema's keys; partOptions: optionSchema("transfer parts")
+//     options: the transfer schema's keys; partOptions: optionSchema("transfer-parts")
 //     → {ok, positions: Float64Array (#V·3, final), positionsLevel1: Float64Array (#V·3),
+//        level1: the level-1 transfer's fields as poseTransfer returns them (gamma, k, ms, ...),
 //        partsJson: the part pairs used (part-file text, e.g. the proposals to edit),
-//        parts: [{name, level, ok, message, sourceVertices, referenceVertices, subdivisions,
-//                 landmarks, rotationDegrees, seamDihedralMean, seamDihedralMax, rejected, ms}],
+//        parts: [{name, level, ok, message, sourceVertices: Uint32Array (the part's source
+//                 vertices), sourceVertexCount, referenceVertices, subdivisions, landmarks,
+//                 rotationDegrees, seamDihedralMean, seamDihedralMax, rejected, ms}],
 //        folds: {reference, source, level1, result, flipsLevel1, flips} (self-intersecting
 //                triangle pairs; flipped faces against the source),
 //        ms: {level1, parts, total}}
@@ -43,6 +45,37 @@ using emscripten::val;
 
 namespace {
 
+// The level-1 fields of a pose transfer result (poseTransfer's, and partTransfer's `level1`).
+void set_pose_fields(val& out, const PoseTransferResult& r) {
+  Eigen::MatrixXd g = r.gamma;
+  out.set("gamma", to_float64_array(g));
+  out.set("k", static_cast<int>(g.rows()));
+  out.set("gammaDominance", r.gamma_dominance);
+  out.set("iterations", r.iterations);
+  out.set("converged", r.converged);
+  out.set("couplingIterations", r.coupling_iterations);
+  out.set("cagePositions", to_float64_array(r.cage_deformed));
+  out.set("cageRest", to_float64_array(r.cage_rest));
+  out.set("cageIndices", to_uint32_array(r.cage_faces));
+  out.set("energy", to_float64_array(Eigen::Map<const Eigen::MatrixXd>(r.energy.data(), r.energy.size(), 1)));
+  val ms = val::object();
+  ms.set("eigenbases", r.ms.eigenbases);
+  ms.set("coupling", r.ms.coupling);
+  ms.set("cage", r.ms.cage);
+  ms.set("mvc", r.ms.mvc);
+  ms.set("optimisation", r.ms.optimisation);
+  ms.set("total", r.ms.total);
+  out.set("ms", ms);
+}
+
+// The part pairs of a spec, depth first (the order of PartTransferResult::reports).
+void flatten_parts(const std::vector<PartPair>& parts, std::vector<const PartPair*>* out) {
+  for (const PartPair& p : parts) {
+    out->push_back(&p);
+    flatten_parts(p.children, out);
+  }
+}
+
 val pose_transfer_js(val ref_positions, val ref_indices, val src_positions, val src_indices, val landmarks,
                      val options, val progress, val cage_positions, val cage_indices) {
   {
@@ -62,25 +95,7 @@ val pose_transfer_js(val ref_positions, val ref_indices, val src_positions, val 
     val out = status_object(r.status);
     if (!r.status.ok()) return out;
     out.set("positions", to_float64_array(r.V));
-    Eigen::MatrixXd g = r.gamma;
-    out.set("gamma", to_float64_array(g));
-    out.set("k", static_cast<int>(g.rows()));
-    out.set("gammaDominance", r.gamma_dominance);
-    out.set("iterations", r.iterations);
-    out.set("converged", r.converged);
-    out.set("couplingIterations", r.coupling_iterations);
-    out.set("cagePositions", to_float64_array(r.cage_deformed));
-    out.set("cageRest", to_float64_array(r.cage_rest));
-    out.set("cageIndices", to_uint32_array(r.cage_faces));
-    out.set("energy", to_float64_array(Eigen::Map<const Eigen::MatrixXd>(r.energy.data(), r.energy.size(), 1)));
-    val ms = val::object();
-    ms.set("eigenbases", r.ms.eigenbases);
-    ms.set("coupling", r.ms.coupling);
-    ms.set("cage", r.ms.cage);
-    ms.set("mvc", r.ms.mvc);
-    ms.set("optimisation", r.ms.optimisation);
-    ms.set("total", r.ms.total);
-    out.set("ms", ms);
+    set_pose_fields(out, r);
     return out;
   }
 }
@@ -111,13 +126,23 @@ val part_transfer_js(val ref_positions, val ref_indices, val src_positions, val 
   out.set("positionsLevel1", to_float64_array(r.V_level1));
   out.set("partsJson", io::parts_json(r.parts));
   val list = val::array();
-  for (const PartReport& p : r.reports) {
+  // Each part's source vertices (its region on the source input mesh, whose vertex ids the
+  // result shares), for the page's part colours.
+  std::vector<const PartPair*> flat_parts;
+  flatten_parts(r.parts.parts, &flat_parts);
+  for (size_t i = 0; i < r.reports.size(); ++i) {
+    const PartReport& p = r.reports[i];
     val o = val::object();
+    if (flat_parts.size() == r.reports.size()) {
+      std::vector<int> vertices;
+      if (part_vertices(src.V, src.F, flat_parts[i]->source, &vertices).ok())
+        o.set("sourceVertices", to_uint32_array(Eigen::Map<const Eigen::MatrixXi>(vertices.data(), static_cast<Eigen::Index>(vertices.size()), 1)));
+    }
     o.set("name", p.name);
     o.set("level", p.level);
     o.set("ok", p.status.ok());
     o.set("message", p.status.message);
-    o.set("sourceVertices", p.source_vertices);
+    o.set("sourceVertexCount", p.source_vertices);
     o.set("referenceVertices", p.reference_vertices);
     o.set("subdivisions", p.subdivisions);
     o.set("landmarks", p.landmarks);
@@ -137,6 +162,9 @@ val part_transfer_js(val ref_positions, val ref_indices, val src_positions, val 
   folds.set("flipsLevel1", r.folds_level1.flipped_faces);
   folds.set("flips", r.folds.flipped_faces);
   out.set("folds", folds);
+  val level1 = val::object();
+  set_pose_fields(level1, r.level1);
+  out.set("level1", level1);
   val ms = val::object();
   ms.set("level1", r.ms_level1);
   ms.set("parts", r.ms_parts);

@@ -552,8 +552,16 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     // Transfer I already gives the part the reference part's orientation (the low frequencies
     // carry it), so a large frame rotation means an ill-conditioned frame (a short or straight
     // part whose average point lies near the axis): measured up to 167° on cat-07/cat-05 parts,
-    // all rejected by the gate below. Such rotations are not applied.
-    if (rep.rotation_degrees > opt.max_registration_degrees) Rot.setIdentity();
+    // all rejected by the gate below. Such rotations are not applied: the rotation is tapered
+    // from full at max_registration_degrees − 15° to none at + 15° (a hard cut made the result
+    // jump with the last bits of the estimate: cat-01's second part measured 46.1° natively and
+    // 43.0° in wasm, one side of the cut each).
+    const double taper_lo = opt.max_registration_degrees - 15, taper_hi = opt.max_registration_degrees + 15;
+    const double keep = std::clamp((taper_hi - rep.rotation_degrees) / (taper_hi - taper_lo), 0.0, 1.0);
+    if (keep < 1) {
+      const Eigen::AngleAxisd aa(Rot);
+      Rot = Eigen::AngleAxisd(keep * aa.angle(), aa.axis()).toRotationMatrix();
+    }
     const Eigen::Vector3d bt = part_boundary_centroid(T, S.boundary);
     const Eigen::Vector3d bs = part_boundary_centroid(S.V, S.boundary);
     Eigen::MatrixXd Treg(T.rows(), 3);
@@ -590,13 +598,13 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     rep.seam_vertices = static_cast<int>(region.roi.size());
     for (int v : handle) region.roi.push_back(v);
     std::sort(region.roi.begin(), region.roi.end());
-    LaplacianEditOptions eo;
-    eo.handle_basis = false;
-    LaplacianEditor editor;
     Eigen::MatrixXd targets = Vcur;
     for (int i = 0; i < static_cast<int>(S.from.size()); ++i) targets.row(S.from[i]) = Treg.row(i);
     double l1_mean = 0, l1_max = 0;
     part_seam_dihedral(Vcur, source.V, source.F, in_part, &l1_mean, &l1_max);
+    LaplacianEditOptions eo;
+    eo.handle_basis = false;
+    LaplacianEditor editor;
     if (Status s = editor.precompute(Vcur, source.F, region, eo, pp_progress.sub(0.8, 0.95)); !s.ok()) {
       if (s.code == StatusCode::Cancelled) return s;
       return skip(Status::error(s.code, "gluing: " + s.message));

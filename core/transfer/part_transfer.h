@@ -103,7 +103,7 @@ struct PartTransferOptions {
   double neck_ratio = 2.0;       // isoline perimeter growth (× narrowest so far) that marks the body
   double max_part_area = 0.3;    // a proposed part covers at most this fraction of the surface
   double min_part_fraction = 0.03; // ... and at least this fraction of the vertices
-  double max_registration_degrees = 45; // larger local-frame rotations are not applied (see .cpp)
+  double max_registration_degrees = 45; // larger local-frame rotations are not applied (tapered over ±15°; see .cpp)
 };
 
 struct FoldReport {

@@ -13,7 +13,7 @@ int run_options(const std::vector<std::string>& argv) {
   Status s = args.parse(argv, {"help", "json"});
   if (!s.ok()) return report("options", s);
   if (args.has("help") || args.positional().size() > 1) {
-    std::cout << "usage: meshmorph options [edit|merge|transfer|retarget] [--json]\n"
+    std::cout << "usage: meshmorph options [JOB] [--json]   (JOB: " << app::job_names() << ")\n"
                  "  Lists each job's options with defaults, ranges and help; --json prints the schema\n"
                  "  the page builds its options panels from ({\"jobs\": [...]}).\n";
     return args.has("help") ? 0 : 2;

@@ -69,6 +69,38 @@ test('different connectivity needs landmarks; the repository landmark file reads
   assert.throws(() => readLandmarkFile({}, counts), /"pairs"/);
 });
 
+test('partTransfer: a part file through the op; labels, the level-1 result and the parts used come back', async () => {
+  const ctx = await makeContext();
+  meshOps.load(ctx, { name: 'lion-05.ply', slot: 'reference' }, fileBuffers('pose/lion-05.ply'));
+  meshOps.load(ctx, { name: 'lion-reference.ply', slot: 'source' }, fileBuffers('pose/lion-reference.ply'));
+  // One front leg (the lion-05 proposal's tip, tests/part_transfer_test.cpp) with its paw nested.
+  const parts = JSON.stringify({ parts: [{ name: 'front leg', source: { disk: { seed: 1449, radius: 0.2 } },
+    children: [{ name: 'paw', source: { disk: { seed: 1449, radius: 0.08 } } }] }] });
+  const { buffers, info } = ops.partTransfer(ctx, { referenceSlot: 'reference', sourceSlot: 'source', parts, partOptions: { seam_rings: 3 } });
+  const n = ctx.state.meshes.get('source').weldedPositions.length;
+  assert.equal(buffers.positions.length, n);
+  assert.equal(buffers.positionsLevel1.length, n);
+  assert.deepEqual(info.parts.map((p) => [p.name, p.level]), [['front leg', 2], ['paw', 3]]);
+  assert.ok(info.level1.k > 0 && info.level1.gamma.length === info.level1.k ** 2 && Number.isFinite(info.level1.gammaDominance));
+  // Labels: the paw (deepest) inside the leg, the rest of the lion outside both.
+  const count = (label) => buffers.partLabels.filter((l) => l === label).length;
+  assert.ok(count(1) > 0 && count(0) > 0 && count(-1) > n / 3 / 2, `labels: leg ${count(0)}, paw ${count(1)}, none ${count(-1)}`);
+  assert.equal(count(0) + count(1), info.parts[0].sourceVertexCount);
+  assert.equal(count(1), info.parts[1].sourceVertexCount);
+  // A kept part moved its vertices; the rest stayed at level 1.
+  let movedInside = 0, movedOutside = 0;
+  for (let v = 0; v < n / 3; ++v) {
+    const d = Math.hypot(...[0, 1, 2].map((k) => buffers.positions[3 * v + k] - buffers.positionsLevel1[3 * v + k]));
+    if (buffers.partLabels[v] >= 0) movedInside = Math.max(movedInside, d);
+    else movedOutside = Math.max(movedOutside, d);
+  }
+  if (info.parts.some((p) => p.ok && !p.rejected)) assert.ok(movedInside > 1e-4, `no part vertex moved (${movedInside})`);
+  assert.deepEqual(JSON.parse(info.partsJson).parts.map((p) => p.name), ['front leg']);
+  for (const key of ['reference', 'source', 'level1', 'result', 'flipsLevel1', 'flips']) assert.ok(Number.isInteger(info.folds[key]), key);
+  assert.ok(info.ms.total >= info.ms.level1);
+  expectCode(() => ops.partTransfer(ctx, { referenceSlot: 'reference', sourceSlot: 'source', parts: '{"parts": [{"source": {"disk": {"seed": 99999, "radius": 0.1}}}]}' }), 'InvalidArgument');
+});
+
 test('landmark clicks pair a reference vertex with a source vertex in either order', () => {
   const l = new LandmarkPairs();
   assert.equal(l.click('reference', 3), 'pending');

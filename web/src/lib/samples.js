@@ -9,6 +9,7 @@ export const samples = [
   { id: 'robot', label: 'RobotExpressive (GLB)', path: 'anim/RobotExpressive/RobotExpressive.glb', credit: 'Tomás Laulhé (Quaternius), CC0', license: 'RobotExpressive-README.md' },
   { id: 'woman', label: 'Human woman (PLY)', path: 'anim/human_woman.ply', credit: 'Max Planck Society via SMPL, adapted by O. Stein', license: 'odedstein-human-README.md' },
   { id: 'cat', label: 'Cat, reference pose (PLY)', path: 'pose/cat-reference.ply', credit: 'R. Sumner and J. Popović, Deformation Transfer (2004)', license: 'sumner-deftransfer-README.txt' },
+  { id: 'cat-01', label: 'Cat, pose 01 (PLY)', path: 'pose/cat-01.ply', credit: 'R. Sumner and J. Popović, Deformation Transfer (2004)', license: 'sumner-deftransfer-README.txt' },
   { id: 'cat-07', label: 'Cat, pose 07 (PLY)', path: 'pose/cat-07.ply', credit: 'R. Sumner and J. Popović, Deformation Transfer (2004)', license: 'sumner-deftransfer-README.txt' },
   { id: 'lion', label: 'Lion, reference pose (PLY)', path: 'pose/lion-reference.ply', credit: 'R. Sumner and J. Popović, Deformation Transfer (2004)', license: 'sumner-deftransfer-README.txt' },
   { id: 'hand', label: 'Hand, low resolution (PLY)', path: 'edit/hand_lowres.ply', credit: 'Max Planck Society via SMPL, adapted by O. Stein', license: 'odedstein-hand-README.md' },

@@ -65,7 +65,7 @@ export class PairView {
   // Overlay needs the see-through analysis material; otherwise the toggle decides.
   applyMaterials() {
     for (const side of Object.values(this.sides)) {
-      const useDocument = side.document && this.materialMode === 'document' && this.mode !== 'overlay';
+      const useDocument = side.document && this.materialMode === 'document' && this.mode !== 'overlay' && !side.analysis.vertexColors;
       side.mesh.material = useDocument ? side.document.materials : side.analysis;
     }
     this.viewer.requestRender();
@@ -143,6 +143,8 @@ export class PairView {
     disposeDocumentMaterials(side.document);
     side.document = null;
     side.mesh.material = side.analysis;
+    side.analysis.vertexColors = false; // a new mesh has no part colours (setColors)
+    side.analysis.color.set(sideColors[name]);
     side.analysis.side = open ? THREE.DoubleSide : THREE.FrontSide;
     side.analysis.needsUpdate = true;
     side.mesh.userData.pickSide = side.analysis.side;
@@ -168,6 +170,20 @@ export class PairView {
     side.picker.refitLater();
     this.layout();
     this.viewer.requestRender();
+  }
+
+  // Per-vertex colours on a side's analysis material (raw layout, 3 floats a vertex; the Transfer
+  // job's part regions), or null to go back to the plain side colour. While colours are on, the
+  // side is drawn with the analysis material (the glTF's own would hide them).
+  setColors(name, colors) {
+    const side = this.sides[name];
+    const geometry = side.mesh.geometry;
+    if (colors) geometry.setAttribute('color', new THREE.BufferAttribute(colors, 3));
+    else geometry.deleteAttribute('color');
+    side.analysis.color.set(colors ? 0xffffff : sideColors[name]);
+    side.analysis.vertexColors = Boolean(colors);
+    side.analysis.needsUpdate = true;
+    this.applyMaterials();
   }
 
   // Display size: both sides scaled to bounding radius 1 and centred on their bounding boxes,

@@ -62,7 +62,7 @@ export interface OptionDescription {
   flag: string;                 // the CLI flag, e.g. "--cage-vertices"
   help: string;                 // one line
 }
-export interface OptionSchema { job: 'edit' | 'transfer' | 'retarget' | 'joints' | 'merge'; summary: string; options: OptionDescription[] }
+export interface OptionSchema { job: 'edit' | 'transfer' | 'transfer-parts' | 'retarget' | 'joints' | 'merge'; summary: string; options: OptionDescription[] }
 
 export interface MeshMorphModule {
   /** The options schema of a job (`meshmorph options --json` prints the same). */
@@ -161,10 +161,11 @@ export type Op = (ctx: OpContext, options: object, buffers: Buffers) => { buffer
 // suggestLandmarks {referenceSlot?, sourceSlot?, count? = 8, sameConnectivity?}
 //          → {} / {pairs: [[r, s, cost]] (welded), reference, source: {centre, radius,
 //            extremities: [{vertex, relative, direction}], between}}
-// partTransfer: a binding only so far (wasm/bind_transfer.cpp, hierarchical part transfer, issue
-//          16), no worker op or panel yet: (reference, source as welded arrays, landmarks, parts =
-//          "auto" | part-file text, transfer options, part options, progress) → {positions,
-//          positionsLevel1, partsJson, parts, folds, ms}
+// partTransfer {referenceSlot?, sourceSlot?, landmarks?, parts: 'auto' | part-file text,
+//          partOptions?: optionSchema {job: 'transfer-parts'}, ...transfer options}
+//          → {positions, positionsLevel1, partLabels: Int32Array (deepest part per welded source
+//            vertex, -1 outside)} / {level1 (as transfer's info), partsJson, parts: [{name, level,
+//            ok, message, rejected, ...}], folds, ms} (hierarchical part transfer, paper 000 Sec. 4.3)
 // ---- edit ops (ops/edit.js): positions results carry {positions, rawPositions, rawNormals}
 // ---- debug ops (ops/debug.js; the e2e recovery checks only)
 // debugExhaustMemory {} → {} / {allocatedMB};  debugCrash {} → the worker dies after answering

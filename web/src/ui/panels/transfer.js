@@ -9,14 +9,22 @@
 //   4 run (method yin / kovnatsky / levy, options from optionSchema {job: 'transfer'})
 //   5 compare (Γ dominance, Γ heat map, flipped faces and detail change from `compare`, result
 //     against source) and export the result as GLB (the source's asset with the new positions).
+// Parts (paper 000 Sec. 4.3, worker op `partTransfer`): with Parts = automatic or a loaded part
+// file (the CLI's --parts JSON) the run is the hierarchical transfer — the whole-body result
+// (shown as Level 1), then each part pair transferred again and glued back; the result lists
+// every part (kept, rejected by the quality gate, or skipped, with the core's reason), colours
+// the parts on the source side, and Save parts writes the pairs used (the proposals, to edit).
 // Both meshes are shown side by side (view/pair-view.js) while the job is shown; the Mesh and
 // Edit jobs keep their own mesh. The meshes live in their own worker slots (slots below).
 // State it owns (window.__meshmorph.state.transfer): {step, reference, source ({name,
 // rawVertices, weldedVertices} or null), sameConnectivity, pairs, pending, selected, method,
-// result ({info, metrics, toReference, options}) or null, showing ('source' | 'result'), runs,
-// saved (the last saved landmark file), exports}. Test hooks (window.__meshmorph.hooks):
+// result ({info, metrics, toReference, options, parts?: {info (partTransfer's), labels}}) or
+// null, showing ('source' | 'level1' | 'result'), runs, saved (the last saved landmark file),
+// exports, parts ('none' | 'auto' | 'file'), partsFile ({name, text, count}) or null}. Test hooks (window.__meshmorph.hooks):
 // transferVertexOnScreen(side, rawVertex) → {x, y, visible}, transferResult() → welded
-// positions or null, transferShown(side = 'source') → a side's displayed (raw) positions.
+// positions or null, transferLevel1() → the level-1 welded positions of a parts run or null,
+// transferShown(side = 'source') → a side's displayed (raw) positions, transferColors() → the
+// source side's vertex colours (raw, 3 a vertex) or null.
 import { unweldValues } from '../../lib/arrays.js';
 import { LandmarkPairs, landmarkFile, minLandmarks, readLandmarkFile } from '../../lib/landmarks.js';
 import { samples } from '../../lib/samples.js';
@@ -99,17 +107,34 @@ const markup = `
     </select>
     <button id="tr-run" type="button" data-idle>Run transfer</button>
   </div>
+  <div class="row">
+    <label for="tr-parts" title="Paper 000 Sec. 4.3: after the whole-body transfer, corresponding parts (limbs, head, tail) are transferred again as pairs of their own and glued back">Parts</label>
+    <select id="tr-parts" data-idle>
+      <option value="none" title="the whole-body transfer only">none (one level)</option>
+      <option value="auto" title="parts proposed where the result's pose disagrees most with the reference, cut at narrow necks">automatic</option>
+      <option value="file" disabled title="the part pairs of a loaded part file">from file</option>
+    </select>
+    <label class="button file" title="A part file: the CLI's --parts JSON (plane cuts or geodesic disks around a seed vertex, nested levels)">Load parts…<input type="file" id="tr-parts-load" accept=".json,application/json" data-idle /></label>
+    <button id="tr-parts-save" type="button" title="The part pairs of the last run (with automatic parts: the proposals, to edit and load again) as the CLI's --parts JSON" disabled>Save parts</button>
+  </div>
+  <p id="tr-parts-hint" class="hint"></p>
   <div id="tr-options"></div>
+  <div id="tr-part-options"></div>
   <div id="tr-result" hidden>
     <h3>Result</h3>
     <div class="row" role="radiogroup" aria-label="Show">
       <label><input type="radio" name="tr-show" value="source" /> Source</label>
+      <label id="tr-show-level1" title="The whole-body transfer before the parts were glued back"><input type="radio" name="tr-show" value="level1" /> Level 1</label>
       <label><input type="radio" name="tr-show" value="result" checked /> Result</label>
       <button id="tr-export" type="button" data-idle>Export GLB</button>
     </div>
     <div class="gamma-row">
       <div id="tr-gamma"></div>
       <dl id="tr-metrics" class="metrics"></dl>
+    </div>
+    <div id="tr-parts-result" hidden>
+      <div class="row"><label title="Each part's region in its own colour on the source side"><input type="checkbox" id="tr-part-colours" checked /> Colour the parts</label></div>
+      <table class="landmarks parts"><thead><tr><th>#</th><th>part</th><th>level</th><th>result</th><th>vertices</th><th title="registration by the local frames (Sec. 4.3)">rotation</th></tr></thead><tbody></tbody></table>
     </div>
   </div>
 </section>`;
@@ -119,6 +144,17 @@ function weldedToRaw(toWelded, count) {
   const out = new Int32Array(count).fill(-1);
   for (let r = toWelded.length - 1; r >= 0; --r) out[toWelded[r]] = r;
   return out;
+}
+
+// Raw-layout vertex colours of part regions: labels per welded vertex (-1 outside every part).
+function partRegionColors(labels, toWelded) {
+  const colors = new Float32Array(3 * toWelded.length);
+  for (let r = 0; r < toWelded.length; ++r) {
+    const label = labels[toWelded[r]];
+    const c = label < 0 ? [0.85, 0.8, 0.75] : pairColor(label);
+    colors.set(c, 3 * r);
+  }
+  return colors;
 }
 
 const sameArrays = (a, b) => a.length === b.length && a.every((v, i) => v === b[i]);
@@ -134,7 +170,7 @@ export const panel = {
     const transfer = {
       step: 0, reference: null, source: null, sameConnectivity: false, pairs: [], pending: null, selected: -1,
       method: 'yin', result: null, showing: 'result', runs: 0, saved: null, exports: 0,
-      view: 'side', linked: true, suggestions: [], loading: null,
+      view: 'side', linked: true, suggestions: [], loading: null, parts: 'none', partsFile: null,
     };
     state.transfer = transfer;
 
@@ -168,7 +204,11 @@ export const panel = {
     const meshes = { reference: null, source: null };
     let result = null;       // welded result positions (Float32Array #W·3) of the last run
     let resultRaw = null;    // the same in the source's raw layout
+    let level1 = null;       // a parts run's level-1 result (welded)
+    let level1Raw = null;    // the same, raw layout
+    let partColors = null;   // a parts run's region colours, raw layout (3 a vertex)
     let form = null;
+    let partForm = null;
     let visible = false;
 
     // ---- showing the state
@@ -230,8 +270,11 @@ export const panel = {
 
     function showSource() {
       if (!meshes.source) return;
-      const showResult = transfer.showing === 'result' && resultRaw;
-      pair.setPositions('source', (showResult ? resultRaw : meshes.source.restRaw).slice());
+      let shown = meshes.source.restRaw;
+      if (transfer.showing === 'result' && resultRaw) shown = resultRaw;
+      else if (transfer.showing === 'level1' && level1Raw) shown = level1Raw;
+      pair.setPositions('source', shown.slice());
+      pair.setColors('source', partColors && $('tr-part-colours').checked ? partColors : null);
       showMarkers();
     }
 
@@ -477,8 +520,12 @@ export const panel = {
     function clearResult() {
       result = null;
       resultRaw = null;
+      level1 = null;
+      level1Raw = null;
+      partColors = null;
       transfer.result = null;
       gammaMap.hide();
+      showParts();
       if (meshes.source) showSource();
     }
 
@@ -494,7 +541,17 @@ export const panel = {
       const method = $('tr-method').value;
       const options = { referenceSlot: slots.reference, sourceSlot: slots.source, method, ...(form ? form.values() : {}) };
       if (landmarks.pairs.length) options.landmarks = landmarks.pairs.map((p) => [...p]);
-      const ran = await app.runOp(`Pose transfer (${method})`, 'transfer', options);
+      const partsMode = $('tr-parts').value;
+      if (partsMode === 'file' && !transfer.partsFile) {
+        app.showError({ code: 'InvalidArgument', message: 'Parts: from file, but no part file is loaded (Load parts…)' });
+        return;
+      }
+      const withParts = partsMode !== 'none';
+      const ran = withParts
+        ? await app.runOp(`Part transfer (${method}, ${partsMode === 'auto' ? 'automatic parts' : transfer.partsFile.name})`, 'partTransfer', {
+          ...options, parts: partsMode === 'auto' ? 'auto' : transfer.partsFile.text, partOptions: partForm ? partForm.values() : {},
+        })
+        : await app.runOp(`Pose transfer (${method})`, 'transfer', options);
       if (!ran) return;
       const positions = ran.buffers.positions;
       // compare: the result against the source (flipped faces, detail change); for
@@ -506,16 +563,26 @@ export const panel = {
         : null;
       result = positions;
       resultRaw = unweldValues(positions, meshes.source.toWelded, 3);
+      level1 = withParts ? ran.buffers.positionsLevel1 : null;
+      level1Raw = withParts ? unweldValues(ran.buffers.positionsLevel1, meshes.source.toWelded, 3) : null;
+      partColors = withParts ? partRegionColors(ran.buffers.partLabels, meshes.source.toWelded) : null;
       transfer.runs += 1;
       transfer.method = method;
-      transfer.result = { info: ran.info, metrics: metrics.info, toReference: toReference?.info ?? null, options: { ...options, landmarks: options.landmarks ? options.landmarks.length : 'generated' } };
+      transfer.result = {
+        info: withParts ? ran.info.level1 : ran.info, metrics: metrics.info, toReference: toReference?.info ?? null,
+        options: { ...options, landmarks: options.landmarks ? options.landmarks.length : 'generated', parts: partsMode },
+        parts: withParts ? { info: { ...ran.info, level1: undefined }, labels: Array.from(ran.buffers.partLabels) } : null,
+      };
       transfer.showing = 'result';
       root.querySelector('input[name="tr-show"][value="result"]').checked = true;
       showSource();
       pair.frame();
       showResultInfo();
+      showParts();
       refresh();
-      app.setStatus(`transfer (${method}): ${fixed(ran.info.ms.total / 1000, 3)} s`);
+      app.setStatus(withParts
+        ? `part transfer (${method}): ${fixed(ran.info.ms.total / 1000, 3)} s, ${ran.info.parts.filter((p) => p.ok && !p.rejected).length} of ${ran.info.parts.length} parts kept`
+        : `transfer (${method}): ${fixed(ran.info.ms.total / 1000, 3)} s`);
     });
 
     function showResultInfo() {
@@ -530,12 +597,89 @@ export const panel = {
       ];
       if (toReference) rows.push(['to reference', `mean ${fixed(toReference.vertexErrorMean)} × diagonal (same connectivity: the reference's pose itself)`]);
       rows.push(['solve', `${options.method}: ${options.method === 'yin' ? `${info.iterations} cage iterations${info.converged ? '' : ' (cap reached)'}, ` : ''}${info.couplingIterations} coupling steps, ${fixed(info.ms.total / 1000)} s`]);
+      const parts = transfer.result.parts?.info;
+      if (parts) {
+        const kept = parts.parts.filter((p) => p.ok && !p.rejected).length;
+        rows.push(['parts', `${kept} of ${parts.parts.length} kept (level 1 ${fixed(parts.ms.level1 / 1000)} s, parts ${fixed(parts.ms.parts / 1000)} s)`]);
+        const f = parts.folds;
+        rows.push(['self-intersections', `result ${f.result}, level 1 ${f.level1} (reference ${f.reference} + source ${f.source}); flipped faces ${f.flips} (level 1 ${f.flipsLevel1})`]);
+      }
       const list = $('tr-metrics');
       list.replaceChildren();
       for (const [term, text] of rows) {
         list.append(Object.assign(document.createElement('dt'), { textContent: term }), Object.assign(document.createElement('dd'), { textContent: text }));
       }
     }
+
+    // The parts of a parts run: a table (status from the core) and a colour per part region.
+    function showParts() {
+      const parts = transfer.result?.parts?.info;
+      $('tr-parts-result').hidden = !parts;
+      $('tr-show-level1').hidden = !parts;
+      $('tr-parts-save').disabled = !parts;
+      const body = root.querySelector('#tr-parts-result tbody');
+      body.replaceChildren();
+      if (!parts) return;
+      parts.parts.forEach((p, i) => {
+        let outcome = 'kept';
+        if (!p.ok) outcome = `skipped: ${p.message}`;
+        else if (p.rejected) outcome = `rejected: ${p.message}`;
+        const row = fromHtml(`<tr><td class="part-chip"></td><td></td><td>${p.level}</td><td class="outcome"></td><td>${p.sourceVertexCount}</td><td>${fixed(p.rotationDegrees, 2)}°</td></tr>`);
+        const chip = row.querySelector('.part-chip');
+        chip.textContent = String(i + 1);
+        chip.style.background = `rgb(${pairColor(i).map((v) => Math.round(255 * v)).join(', ')})`;
+        // Proposed parts are named "auto 2 (disagreement 110.2 at vertex 6205)": the short name in
+        // the table, the rest and the timings as the row's tooltip.
+        const short = p.name.replace(/\s*\(.*\)\s*$/, '') || p.name;
+        row.children[1].textContent = short;
+        row.title = `${p.name}: ${p.subdivisions} subdivision(s), ${p.landmarks} landmarks, frame rotation ${fixed(p.rotationDegrees)}°, seam dihedral change mean ${fixed(p.seamDihedralMean)}° max ${fixed(p.seamDihedralMax)}°, ${fixed(p.ms / 1000)} s`;
+        row.querySelector('.outcome').textContent = outcome;
+        row.classList.toggle('rejected', outcome !== 'kept');
+        body.append(row);
+      });
+    }
+
+    $('tr-part-colours').addEventListener('change', () => showSource());
+
+    function showPartsHint() {
+      const mode = $('tr-parts').value;
+      transfer.parts = mode;
+      let hint = '';
+      if (mode === 'auto') hint = 'After the whole-body transfer, parts where the pose still disagrees most (limbs, head, tail) are proposed, transferred again and glued back; a part that would add folds or flips is rejected. Save parts gives the proposals to edit.';
+      else if (mode === 'file') hint = `${transfer.partsFile.count} part pair${transfer.partsFile.count === 1 ? '' : 's'} from ${transfer.partsFile.name}.`;
+      $('tr-parts-hint').textContent = hint;
+      if (partForm) partForm.element.hidden = mode === 'none';
+    }
+    $('tr-parts').addEventListener('change', showPartsHint);
+
+    $('tr-parts-load').addEventListener('change', async () => {
+      const file = $('tr-parts-load').files[0];
+      $('tr-parts-load').value = '';
+      if (!file) return;
+      const text = await file.text();
+      let count = 0;
+      try {
+        const countPairs = (list) => (Array.isArray(list) ? list.reduce((n, p) => n + 1 + countPairs(p?.children), 0) : 0);
+        const parsed = JSON.parse(text);
+        if (!Array.isArray(parsed?.parts) || parsed.parts.length === 0) throw new Error('no "parts" array with at least one part pair');
+        count = countPairs(parsed.parts);
+      } catch (e) {
+        app.showError({ code: 'ParseError', message: `${file.name}: ${e.message} (a part file is {"parts": [{"name", "source": {"disk": {"seed", "radius"}} | {"plane": ...}, "reference"?, "children"?}]})` });
+        return;
+      }
+      transfer.partsFile = { name: file.name, text, count };
+      const option = $('tr-parts').querySelector('option[value="file"]');
+      option.disabled = false;
+      option.textContent = `from ${file.name}`;
+      $('tr-parts').value = 'file';
+      showPartsHint();
+    });
+
+    $('tr-parts-save').addEventListener('click', () => {
+      const parts = transfer.result?.parts?.info;
+      if (!parts || !meshes.reference || !meshes.source) return;
+      download(new TextEncoder().encode(parts.partsJson), `${stem(meshes.reference.info.name)}-${stem(meshes.source.info.name)}-parts.json`, 'application/json');
+    });
 
     for (const radio of root.querySelectorAll('input[name="tr-show"]')) {
       radio.addEventListener('change', () => {
@@ -571,6 +715,10 @@ export const panel = {
         }
         form = new OptionsForm(schema.options.filter((o) => o.name !== 'method'), { title: 'Transfer options' });
         $('tr-options').append(form.element);
+        const partSchema = (await client.run('optionSchema', { job: 'transfer-parts' }).promise).info;
+        partForm = new OptionsForm(partSchema.options, { title: 'Part options' });
+        $('tr-part-options').append(partForm.element);
+        showPartsHint();
       } catch (e) {
         app.showError(e);
       }
@@ -600,7 +748,13 @@ export const panel = {
     }));
     // Welded → raw for a side (tests place the pointer on displayed vertices).
     app.hooks.transferRawVertex = (side, welded) => meshes[side]?.weldedToRaw[welded] ?? -1;
+    showParts();
     app.hooks.transferResult = () => (result ? Array.from(result) : null);
+    app.hooks.transferLevel1 = () => (level1 ? Array.from(level1) : null);
+    app.hooks.transferColors = () => {
+      const c = pair.sides.source.mesh.geometry.getAttribute('color');
+      return pair.sides.source.analysis.vertexColors && c ? Array.from(c.array) : null;
+    };
     app.hooks.transferShown = (side = 'source') => Array.from(pair.sides[side].mesh.geometry.getAttribute('position').array);
     refresh();
     return root;

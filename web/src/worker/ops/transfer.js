@@ -11,6 +11,17 @@
 //     info {gammaDominance, iterations, converged, couplingIterations, ms, k, gamma: number[]}
 //   Progress messages carry the core's stages (eigenbasis, coupled bases, cage: …,
 //   mean-value coordinates, optimisation); returning false from ctx.progress cancels.
+// partTransfer: hierarchical part transfer (paper 000 Sec. 4.3): the whole-body transfer, then
+//   part pairs transferred again and glued back. options as for transfer, plus
+//   {parts: 'auto' (proposed parts) | the text of a part file (the CLI's --parts JSON),
+//    partOptions: options of optionSchema {job: 'transfer-parts'}}
+//   → buffers {positions (final, welded #V·3), positionsLevel1, partLabels: Int32Array (per
+//     welded source vertex the index of the deepest part that contains it, -1 outside)}
+//     info {level1: the transfer op's info for level 1, partsJson (the parts used: the
+//     proposals with 'auto'), parts: [{name, level, ok, message, rejected, sourceVertexCount,
+//     referenceVertices, subdivisions, landmarks, rotationDegrees, seamDihedralMean,
+//     seamDihedralMax, ms}] (transfer order, depth first), folds {reference, source, level1,
+//     result, flipsLevel1, flips}, ms {level1, parts, total}}
 // compare: options {slotA = 'main', slotB = 'reference'} (same vertex order); buffers
 //   {positionsA?: welded #V·3} compares those positions (e.g. a transfer result) instead of slotA's
 //   → info {vertexErrorMean, vertexErrorMax, laplacianChange, edgeDistortionMean,
@@ -54,6 +65,32 @@ export const ops = {
       info: {
         gammaDominance: r.gammaDominance, iterations: r.iterations, converged: r.converged,
         couplingIterations: r.couplingIterations, ms: r.ms, k: r.k, gamma: Array.from(r.gamma),
+      },
+    };
+  },
+
+  partTransfer(ctx, options = {}) {
+    const { referenceSlot = 'reference', sourceSlot = 'main', landmarks, parts = 'auto', partOptions = {}, ...jobOptions } = options;
+    const reference = meshInSlot(ctx, referenceSlot);
+    const source = meshInSlot(ctx, sourceSlot);
+    const r = unwrap(ctx.module.partTransfer(reference.weldedPositions, reference.weldedIndices,
+      source.weldedPositions, source.weldedIndices, flatLandmarks(landmarks), String(parts), jobOptions, partOptions,
+      (stage, fraction) => ctx.progress(stage, fraction)));
+    const partLabels = new Int32Array(source.weldedPositions.length / 3).fill(-1);
+    // Depth first: a child comes after its parent, so the deepest part wins.
+    r.parts.forEach((p, i) => { for (const v of p.sourceVertices ?? []) partLabels[v] = i; });
+    const l = r.level1;
+    return {
+      buffers: { positions: Float32Array.from(r.positions), positionsLevel1: Float32Array.from(r.positionsLevel1), partLabels },
+      info: {
+        level1: {
+          gammaDominance: l.gammaDominance, iterations: l.iterations, converged: l.converged,
+          couplingIterations: l.couplingIterations, ms: l.ms, k: l.k, gamma: Array.from(l.gamma),
+        },
+        partsJson: r.partsJson,
+        parts: r.parts.map(({ sourceVertices, ...p }) => p),
+        folds: r.folds,
+        ms: r.ms,
       },
     };
   },
