@@ -1306,8 +1306,9 @@ it('recovery: a 1M-vertex mesh, a full wasm heap and a dead worker never take th
   await page.setInputFiles('#file', big);
   await page.waitForFunction(() => window.__meshmorph.state.loads >= 2 || window.__meshmorph.state.error, null, { timeout: 240000 });
   await waitIdle(page, 240000);
-  const loaded = await page.evaluate(() => ({ mesh: window.__meshmorph.state.mesh, error: window.__meshmorph.state.error }));
+  const loaded = await page.evaluate(() => ({ mesh: window.__meshmorph.state.mesh, error: window.__meshmorph.state.error, read: window.__meshmorph.state.lastReadMs, ms: window.__meshmorph.state.lastLoadMs }));
   const loadSeconds = (Date.now() - started) / 1000;
+  if (loaded.ms) console.log(`     1M-vertex load stages: file read ${loaded.read?.toFixed(0)} ms, worker op ${loaded.ms.worker.toFixed(0)} ms, view geometry ${loaded.ms.view.toFixed(0)} ms`);
   measured.bigMesh = loaded.error ? `refused: ${loaded.error.code} ${loaded.error.message}` : `${loaded.mesh.weldedVertices} vertices loaded in ${loadSeconds.toFixed(1)} s`;
   console.log(`     1M-vertex PLY (${(fs.statSync(big).size / 2 ** 20).toFixed(0)} MB): ${measured.bigMesh}`);
   await nextFrame(page);
