@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/threads.h"
 #include "bench.h"
 
 namespace mm::bench {
@@ -62,6 +63,15 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--quick")) ctx.quick = true;
     else if (!std::strcmp(argv[i], "--json") && i + 1 < argc) json_path = argv[++i];
+    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) {
+      // Threads the core may use (common/threads.h): 1 runs every stage in sequence.
+      const int n = std::atoi(argv[++i]);
+      if (n < 1) {
+        std::cerr << "meshmorph_bench: --threads needs a positive count\n";
+        return 2;
+      }
+      mm::set_max_threads(n);
+    }
     else if (!std::strcmp(argv[i], "--list")) {
       for (const auto& [name, fn] : suites()) std::cout << name << "\n";
       return 0;
@@ -74,7 +84,7 @@ int main(int argc, char** argv) {
     }
   for (const auto& [name, fn] : suites()) {
     if (!wanted.empty() && std::find(wanted.begin(), wanted.end(), name) == wanted.end()) continue;
-    std::fprintf(stderr, "running suite %s...\n", name.c_str());
+    std::fprintf(stderr, "running suite %s (%d thread%s)...\n", name.c_str(), mm::max_threads(), mm::max_threads() == 1 ? "" : "s");
     fn(ctx);
   }
   std::printf("%-12s %-22s %8s  %-28s %11s  %-34s %s\n", "suite", "mesh", "#V", "stage", "ms", "peer", "note");
@@ -85,7 +95,7 @@ int main(int argc, char** argv) {
     nlohmann::json j = nlohmann::json::array();
     for (const auto& r : ctx.rows)
       j.push_back({{"suite", r.suite}, {"mesh", r.mesh}, {"vertices", r.vertices}, {"stage", r.stage},
-                   {"ms", r.ms}, {"peer", r.peer}, {"note", r.note}});
+                   {"ms", r.ms}, {"peer", r.peer}, {"note", r.note}, {"threads", mm::max_threads()}});
     std::ofstream(json_path) << j.dump(1) << "\n";
   }
   return 0;

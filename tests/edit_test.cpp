@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "app/edit_spec.h"
+#include "common/threads.h"
 #include "edit/implicit_gradients.h"
 #include "edit/laplacian_editor.h"
 #include "edit/selection.h"
@@ -136,6 +137,30 @@ TEST(Edit, IdentityHandlesReturnInput) {
       EXPECT_LE((f.V - b.mesh.V).cwiseAbs().maxCoeff(), 1e-9) << "variant " << variant;
     }
   }
+}
+
+// Natively the Poisson factor is built on a second thread beside the Eq. 7 system
+// (common/threads.h): one thread and two give the same edit bit for bit.
+TEST(Edit, OneAndTwoThreadsGiveTheSameEdit) {
+  BarCase b = bar_case(true);
+  const HandleTransform T = HandleTransform::similarity(Eigen::Vector3d(0.2, 0.1, 0), Eigen::Vector3d::UnitZ(), 0.7,
+                                                        b.mesh.V.colwise().mean().transpose());
+  Eigen::MatrixXd dragged[2], finalized[2];
+  for (int threads : {1, 2}) {
+    set_max_threads(threads);
+    LaplacianEditor ed;
+    ASSERT_TRUE(ed.precompute(b.mesh.V, b.mesh.F, b.region).ok());
+    EditResult d = ed.drag({T});
+    ASSERT_TRUE(d.status.ok()) << d.status.message;
+    EditResult f = ed.finalize();
+    ASSERT_TRUE(f.status.ok()) << f.status.message;
+    dragged[threads - 1] = d.V;
+    finalized[threads - 1] = f.V;
+  }
+  set_max_threads(0);
+  EXPECT_TRUE(dragged[0] == dragged[1]);
+  EXPECT_TRUE(finalized[0] == finalized[1]);
+  EXPECT_GT((finalized[0] - b.mesh.V).cwiseAbs().maxCoeff(), 0.05);  // the edit moved the bar
 }
 
 // The per-handle response basis (drag) and the three back-substitutions (drag_positions, or

@@ -1,5 +1,6 @@
 #include "edit/laplacian_editor_impl.h"
 
+#include <chrono>
 #include <cmath>
 #include <string>
 
@@ -18,7 +19,8 @@ using namespace edit_detail;
 Status LaplacianEditor::Impl::build_finalize_system(EditBuild& s, const Progress& progress) {
   const bool soft_mode = s.soft_mode, cot = s.cot;
   const double h = s.h;
-  auto& clock = s.clock;
+  // Its own clock: natively this stage may run beside the Eq. 7 system (laplacian_editor.cpp).
+  auto clock = std::chrono::steady_clock::now();
   // Stage 2 operator (undisplaced mesh): W_UU, W_UK and rest Laplacian coordinates.
   EditSparse W2;
   Eigen::VectorXd ds2;

@@ -10,6 +10,7 @@
 #include <Eigen/Cholesky>
 
 #include "cage/mean_value_coordinates.h"
+#include "common/threads.h"
 #include "mesh/validate.h"
 #include "operators/operators.h"
 #include "spectral/spectral_basis.h"
@@ -116,7 +117,8 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
 
   // 4–5. Cage and mean-value coordinates (Yin only). They depend on the source alone, so natively
   // they run on a second thread while the eigenbases and the coupling are computed (the results
-  // are the same either way; in WebAssembly, built without threads, they run in sequence below).
+  // are the same either way; with max_threads() = 1, and in WebAssembly, built without threads,
+  // they run in sequence below).
   // Progress of the cage thread: recorded while this thread still computes its own stages, then
   // forwarded (serialised by a mutex, fractions kept monotone) once this thread only waits for it.
   struct CageStage {
@@ -149,7 +151,7 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
     r.Cn = (r.C.rowwise() - src.centroid) / src.scale;
     MeanValueCoordinates mvc;
 #if !defined(__EMSCRIPTEN__)
-    if (threaded && src.V.rows() >= 2048) {
+    if (threaded && max_threads() > 1 && src.V.rows() >= 2048) {
       // Rows of Ψ are independent: the second half on another thread (by now the eigenbases
       // are usually done and their core is free).
       const Eigen::Index h = src.V.rows() / 2;
@@ -192,7 +194,7 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
   const Progress cage_range = progress.sub(0.4, 0.85);
   std::future<CageStage> cage_future;
 #if !defined(__EMSCRIPTEN__)
-  if (opt.method == TransferMethod::Yin) {
+  if (opt.method == TransferMethod::Yin && max_threads() > 1) {
     const Progress watch([&](const std::string& stage, double f) {
       std::lock_guard<std::mutex> lock(report.mutex);
       f = std::max(f, report.fraction);
