@@ -26,13 +26,12 @@ int default_threads() {
 }  // namespace
 
 int max_threads() {
+  static const int d = default_threads();
 #if defined(__EMSCRIPTEN__)
-  return 1;
+  return d;  // 1: no threads in this build, whatever was asked
 #else
   const int o = g_override.load();
-  if (o >= 1) return o;
-  static const int d = default_threads();
-  return d;
+  return o >= 1 ? o : d;
 #endif
 }
 
