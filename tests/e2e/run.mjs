@@ -1368,7 +1368,7 @@ it('no console warnings or errors during the run', async ({ allConsole }) => {
 // ---- runner
 
 // The tests that also run in Firefox (by name prefix).
-const firefoxTests = ['page loads', 'the default sample mesh renders', 'glTF materials', 'edit: ', 'transfer: ', 'retarget: ', 'merge: ', 'no console'];
+const firefoxTests = ['page loads', 'the default sample mesh renders', 'glTF materials', 'edit: ', 'transfer: ', 'transfer parts: ', 'retarget: ', 'merge: ', 'no console'];
 
 // Installed in every page before its own scripts: the long-task observer (Chromium) and a
 // drop helper that dispatches dragenter / dragover / drop with a file at a fraction of the
