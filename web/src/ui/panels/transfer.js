@@ -18,7 +18,7 @@
 // Edit jobs keep their own mesh. The meshes live in their own worker slots (slots below).
 // State it owns (window.__meshmorph.state.transfer): {step, reference, source ({name,
 // rawVertices, weldedVertices} or null), sameConnectivity, pairs, pending, selected, method,
-// result ({info, metrics, toReference, options, parts?: {info (partTransfer's), labels}}) or
+// result ({info, metrics, toReference, options, parts?: {info (partTransfer's)}}) or
 // null, showing ('source' | 'level1' | 'result'), runs, saved (the last saved landmark file),
 // exports, parts ('none' | 'auto' | 'file'), partsFile ({name, text, count}) or null}. Test hooks (window.__meshmorph.hooks):
 // transferVertexOnScreen(side, rawVertex) → {x, y, visible}, transferResult() → welded
@@ -156,6 +156,9 @@ function partRegionColors(labels, toWelded) {
   }
   return colors;
 }
+
+// Parts a partTransfer run kept (the others were skipped or rejected by the quality gate).
+const keptParts = (parts) => parts.filter((p) => p.ok && !p.rejected);
 
 const sameArrays = (a, b) => a.length === b.length && a.every((v, i) => v === b[i]);
 const fixed = (v, digits = 3) => (Number.isFinite(v) ? Number(v.toPrecision(digits)).toString() : '–');
@@ -571,7 +574,7 @@ export const panel = {
       transfer.result = {
         info: withParts ? ran.info.level1 : ran.info, metrics: metrics.info, toReference: toReference?.info ?? null,
         options: { ...options, landmarks: options.landmarks ? options.landmarks.length : 'generated', parts: partsMode },
-        parts: withParts ? { info: { ...ran.info, level1: undefined }, labels: Array.from(ran.buffers.partLabels) } : null,
+        parts: withParts ? { info: { ...ran.info, level1: undefined } } : null,
       };
       transfer.showing = 'result';
       root.querySelector('input[name="tr-show"][value="result"]').checked = true;
@@ -581,7 +584,7 @@ export const panel = {
       showParts();
       refresh();
       app.setStatus(withParts
-        ? `part transfer (${method}): ${fixed(ran.info.ms.total / 1000, 3)} s, ${ran.info.parts.filter((p) => p.ok && !p.rejected).length} of ${ran.info.parts.length} parts kept`
+        ? `part transfer (${method}): ${fixed(ran.info.ms.total / 1000, 3)} s, ${keptParts(ran.info.parts).length} of ${ran.info.parts.length} parts kept`
         : `transfer (${method}): ${fixed(ran.info.ms.total / 1000, 3)} s`);
     });
 
@@ -599,7 +602,7 @@ export const panel = {
       rows.push(['solve', `${options.method}: ${options.method === 'yin' ? `${info.iterations} cage iterations${info.converged ? '' : ' (cap reached)'}, ` : ''}${info.couplingIterations} coupling steps, ${fixed(info.ms.total / 1000)} s`]);
       const parts = transfer.result.parts?.info;
       if (parts) {
-        const kept = parts.parts.filter((p) => p.ok && !p.rejected).length;
+        const kept = keptParts(parts.parts).length;
         rows.push(['parts', `${kept} of ${parts.parts.length} kept (level 1 ${fixed(parts.ms.level1 / 1000)} s, parts ${fixed(parts.ms.parts / 1000)} s)`]);
         const f = parts.folds;
         rows.push(['self-intersections', `result ${f.result}, level 1 ${f.level1} (reference ${f.reference} + source ${f.source}); flipped faces ${f.flips} (level 1 ${f.flipsLevel1})`]);

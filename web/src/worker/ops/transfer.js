@@ -47,6 +47,14 @@ function flatLandmarks(pairs) {
   return flat;
 }
 
+// The info of a pose transfer result (poseTransfer's, or partTransfer's level1).
+function poseInfo(r) {
+  return {
+    gammaDominance: r.gammaDominance, iterations: r.iterations, converged: r.converged,
+    couplingIterations: r.couplingIterations, ms: r.ms, k: r.k, gamma: Array.from(r.gamma),
+  };
+}
+
 export const ops = {
   transfer(ctx, options = {}, buffers = {}) {
     const { referenceSlot = 'reference', sourceSlot = 'main', landmarks, ...jobOptions } = options;
@@ -62,10 +70,7 @@ export const ops = {
         cagePositions: Float32Array.from(r.cagePositions),
         cageIndices: r.cageIndices,
       },
-      info: {
-        gammaDominance: r.gammaDominance, iterations: r.iterations, converged: r.converged,
-        couplingIterations: r.couplingIterations, ms: r.ms, k: r.k, gamma: Array.from(r.gamma),
-      },
+      info: poseInfo(r),
     };
   },
 
@@ -79,14 +84,10 @@ export const ops = {
     const partLabels = new Int32Array(source.weldedPositions.length / 3).fill(-1);
     // Depth first: a child comes after its parent, so the deepest part wins.
     r.parts.forEach((p, i) => { for (const v of p.sourceVertices ?? []) partLabels[v] = i; });
-    const l = r.level1;
     return {
       buffers: { positions: Float32Array.from(r.positions), positionsLevel1: Float32Array.from(r.positionsLevel1), partLabels },
       info: {
-        level1: {
-          gammaDominance: l.gammaDominance, iterations: l.iterations, converged: l.converged,
-          couplingIterations: l.couplingIterations, ms: l.ms, k: l.k, gamma: Array.from(l.gamma),
-        },
+        level1: poseInfo(r.level1),
         partsJson: r.partsJson,
         parts: r.parts.map(({ sourceVertices, ...p }) => p),
         folds: r.folds,
