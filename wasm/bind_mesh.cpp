@@ -9,8 +9,8 @@
 //     → {ok, asset: number, name, format, warnings: string[], primitives: [...],
 //        positions: Float32Array (#R·3, raw layout, world space), indices: Uint32Array (#T·3),
 //        normals: Float32Array (#R·3, smooth normals of the welded surface, raw layout),
-//        toWelded: Uint32Array (#R), weldedPositions: Float64Array (#W·3),
-//        weldedIndices: Uint32Array (#F·3), report: MeshReport object (of the welded mesh),
+//        toWelded: Uint32Array (#R), weldedVertices: #W, weldedFaces: #F,
+//        report: MeshReport object (of the welded mesh),
 //        text: string and info: object (the `meshmorph info` report and its --json form,
 //        io/info_report.h)}
 //     `name` picks the format by extension. `files` resolves a .gltf's external buffers and
@@ -18,6 +18,10 @@
 //     io::LoadOptions: {weld: {tolerance, drop_degenerate_faces}, skip_unsupported_primitives}.
 //     The asset stays in a registry until disposeAsset(asset).
 //   disposeAsset(asset: number) → boolean (false when unknown)
+//   assetWeldedMesh(asset) → {ok, positions: Float64Array (#W·3), indices: Uint32Array (#F·3)}:
+//     the welded mesh the algorithms work on. Not part of loadAsset's result: at 1M vertices
+//     the two copies are a tenth of the load, and a page that only views the mesh never needs
+//     them (worker/ops/mesh.js fetches them on first use).
 //   exportAsset(asset, positions?: Float64Array|Float32Array (#W·3 welded, world space;
 //               undefined keeps the loaded geometry), format = "glb", options? {recompute_normals})
 //     → {ok, bytes: Uint8Array}
@@ -214,8 +218,8 @@ val load_asset_js(const val& bytes_js, const std::string& name, const val& files
   o.set("indices", to_uint32_array(asset->F_raw));
   o.set("normals", to_float32_array(normals));
   o.set("toWelded", to_uint32_array(asset->weld.to_welded));
-  o.set("weldedPositions", to_float64_array(asset->weld.V));
-  o.set("weldedIndices", to_uint32_array(asset->weld.F));
+  o.set("weldedVertices", static_cast<double>(asset->weld.V.rows()));
+  o.set("weldedFaces", static_cast<double>(asset->weld.F.rows()));
   o.set("report", report_object(info.welded));
   o.set("text", info.text);
   o.set("info", val::global("JSON").call<val>("parse", info.json));
@@ -227,6 +231,16 @@ val load_asset_js(const val& bytes_js, const std::string& name, const val& files
 }
 
 bool dispose_asset_js(int id) { return asset_registry().erase(id) > 0; }
+
+val asset_welded_mesh_js(int id) {
+  const auto it = asset_registry().find(id);
+  if (it == asset_registry().end())
+    return error_object(StatusCode::InvalidArgument, "no loaded asset with id " + std::to_string(id));
+  val o = status_object(Status::success());
+  o.set("positions", to_float64_array(it->second->weld.V));
+  o.set("indices", to_uint32_array(it->second->weld.F));
+  return o;
+}
 
 val export_asset_js(int id, const val& positions, const std::string& format_name,
                     const val& options) {
@@ -328,6 +342,7 @@ val spectral_basis_js(const val& positions, const val& indices, const val& optio
 EMSCRIPTEN_BINDINGS(meshmorph_mesh) {
   bind<&load_asset_js>("loadAsset");
   bind<&dispose_asset_js>("disposeAsset");
+  bind<&asset_welded_mesh_js>("assetWeldedMesh");
   bind<&export_asset_js>("exportAsset");
   bind<&export_asset_with_mesh_js>("exportAssetWithMesh");
   bind<&save_mesh_js>("saveMesh");

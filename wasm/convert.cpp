@@ -1,5 +1,7 @@
 #include "convert.h"
 
+#include <memory>
+
 #include <emscripten/bind.h>
 
 namespace mm::wasm {
@@ -7,29 +9,26 @@ namespace mm::wasm {
 using emscripten::val;
 
 namespace {
-std::vector<double> to_doubles(const val& array) {
+// A JS array (typed or plain) of length ≥ rows·cols read as a row-major rows × cols matrix of T:
+// one `set` into the matrix's own storage (TypedArray.prototype.set converts each element with
+// ToNumber and then to T: for int32, modulo 2^32, so 2^32 − 1 from a Uint32Array reads as −1,
+// an out-of-range index the validation reports). Entries past rows·cols are ignored.
+template <class T>
+Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> read_row_major(const val& array, int cols) {
   if (array.isUndefined() || array.isNull()) return {};
-  return emscripten::convertJSArrayToNumberVector<double>(array);
+  const size_t length = array["length"].as<size_t>();
+  const int rows = static_cast<int>(length / static_cast<size_t>(cols));
+  Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> R(rows, cols);
+  const size_t used = static_cast<size_t>(rows) * static_cast<size_t>(cols);
+  val(emscripten::typed_memory_view(used, R.data()))
+      .call<void>("set", used == length ? array : array.call<val>("slice", 0, used));
+  return R;
 }
 }  // namespace
 
-Eigen::MatrixXd to_matrix(const val& array, int cols) {
-  const std::vector<double> d = to_doubles(array);
-  const int rows = static_cast<int>(d.size()) / cols;
-  Eigen::MatrixXd M(rows, cols);
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c) M(r, c) = d[r * cols + c];
-  return M;
-}
+Eigen::MatrixXd to_matrix(const val& array, int cols) { return read_row_major<double>(array, cols); }
 
-Eigen::MatrixXi to_index_matrix(const val& array, int cols) {
-  const std::vector<double> d = to_doubles(array);
-  const int rows = static_cast<int>(d.size()) / cols;
-  Eigen::MatrixXi M(rows, cols);
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c) M(r, c) = static_cast<int>(d[r * cols + c]);
-  return M;
-}
+Eigen::MatrixXi to_index_matrix(const val& array, int cols) { return read_row_major<int>(array, cols); }
 
 std::vector<uint8_t> to_bytes(const val& array) {
   if (array.isUndefined() || array.isNull()) return {};
@@ -41,38 +40,33 @@ std::vector<int> to_int_vector(const val& array) {
   return emscripten::convertJSArrayToNumberVector<int>(array);
 }
 
-val to_float32_array(const Eigen::MatrixXd& M) {
-  std::vector<float> buf(M.size());
-  for (int r = 0; r < M.rows(); ++r)
-    for (int c = 0; c < M.cols(); ++c) buf[r * M.cols() + c] = static_cast<float>(M(r, c));
-  val out = val::global("Float32Array").new_(buf.size());
-  out.call<void>("set", val(emscripten::typed_memory_view(buf.size(), buf.data())));
-  return out;
+namespace {
+// A new JS typed array of the named type holding a copy of data[0, n): `new T(view)` allocates
+// and copies once (no zero-fill, no second pass); the view is only read during the call.
+template <class T>
+val copy_to_js(const char* type, const T* data, size_t n) {
+  return val::global(type).new_(val(emscripten::typed_memory_view(n, data)));
 }
 
-val to_float64_array(const Eigen::MatrixXd& M) {
-  std::vector<double> buf(M.size());
-  for (int r = 0; r < M.rows(); ++r)
-    for (int c = 0; c < M.cols(); ++c) buf[r * M.cols() + c] = M(r, c);
-  val out = val::global("Float64Array").new_(buf.size());
-  out.call<void>("set", val(emscripten::typed_memory_view(buf.size(), buf.data())));
-  return out;
+// M's entries in row-major order, cast to T, in an uninitialised buffer (a std::vector would
+// zero-fill it first: one more pass over fresh memory, which costs as much as the copy at 1M
+// vertices).
+template <class T, class Derived>
+val row_major_to_js(const char* type, const Eigen::MatrixBase<Derived>& M) {
+  using RowMajor = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  std::unique_ptr<T[]> buf(new T[static_cast<size_t>(M.size())]);
+  Eigen::Map<RowMajor>(buf.get(), M.rows(), M.cols()) = M.template cast<T>();
+  return copy_to_js(type, buf.get(), static_cast<size_t>(M.size()));
 }
+}  // namespace
 
-val to_uint32_array(const Eigen::MatrixXi& M) {
-  std::vector<uint32_t> buf(M.size());
-  for (int r = 0; r < M.rows(); ++r)
-    for (int c = 0; c < M.cols(); ++c) buf[r * M.cols() + c] = static_cast<uint32_t>(M(r, c));
-  val out = val::global("Uint32Array").new_(buf.size());
-  out.call<void>("set", val(emscripten::typed_memory_view(buf.size(), buf.data())));
-  return out;
-}
+val to_float32_array(const Eigen::MatrixXd& M) { return row_major_to_js<float>("Float32Array", M); }
 
-val to_uint8_array(const std::vector<uint8_t>& bytes) {
-  val out = val::global("Uint8Array").new_(bytes.size());
-  out.call<void>("set", val(emscripten::typed_memory_view(bytes.size(), bytes.data())));
-  return out;
-}
+val to_float64_array(const Eigen::MatrixXd& M) { return row_major_to_js<double>("Float64Array", M); }
+
+val to_uint32_array(const Eigen::MatrixXi& M) { return row_major_to_js<uint32_t>("Uint32Array", M); }
+
+val to_uint8_array(const std::vector<uint8_t>& bytes) { return copy_to_js("Uint8Array", bytes.data(), bytes.size()); }
 
 double get_number(const val& obj, const char* name, double fallback) {
   if (obj.isUndefined() || obj.isNull()) return fallback;

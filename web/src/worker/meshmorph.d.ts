@@ -77,13 +77,16 @@ export interface MeshMorphModule {
     indices: Uint32Array;         // #T·3 over the raw layout
     normals: Float32Array;        // #R·3, smooth normals of the welded surface
     toWelded: Uint32Array;        // #R, welded index of every raw vertex
-    weldedPositions: Float64Array; // #W·3
-    weldedIndices: Uint32Array;   // #F·3 over welded vertices
+    weldedVertices: number;       // #W
+    weldedFaces: number;          // #F
     report: MeshReport;           // of the welded mesh
     text: string;                 // `meshmorph info` text (io/info_report.h)
     info: object;                 // `meshmorph info --json`
   }>;
   disposeAsset(asset: number): boolean;
+  /** The asset's welded mesh, the one the algorithms work on (not in loadAsset's result: the
+   *  copies are a tenth of a 1M-vertex load, and a page that only views the mesh never needs them). */
+  assetWeldedMesh(asset: number): Result<{ positions: Float64Array; indices: Uint32Array }>;
   /** Writes the asset (everything in the document kept) with new welded positions (#W·3) or
    *  the loaded ones (undefined). format: 'glb' | 'gltf' | 'obj' | 'off' | 'ply'. */
   exportAsset(asset: number, positions: Float64Array | Float32Array | undefined, format: string,
@@ -140,7 +143,8 @@ export type FromWorker =
 export interface OpContext {
   module: MeshMorphModule;
   state: { meshes: Map<string, { asset: number; name: string; format: string;
-    weldedPositions: Float64Array; weldedIndices: Uint32Array; toWelded: Uint32Array }> } & Record<string, unknown>;
+    weldedPositions: Float64Array; weldedIndices: Uint32Array; // fetched from the asset on first read
+    weldedVertices: number; toWelded: Uint32Array }> } & Record<string, unknown>;
   /** Forward to core progress callbacks; false means the user cancelled. */
   progress(stage: string, fraction: number): boolean;
 }

@@ -6,7 +6,8 @@
 // An op is `(ctx, options, buffers) => {info, buffers}` where
 //   ctx.module   the Emscripten module (meshmorph_web or meshmorph_node)
 //   ctx.state    per-worker state shared by all op files; meshes live in ctx.state.meshes,
-//                a Map slot → {asset, name, format, weldedPositions, weldedIndices, toWelded}
+//                a Map slot → {asset, name, format, weldedVertices, weldedPositions, weldedIndices,
+//                toWelded} (the welded arrays are fetched from the asset on first read)
 //   ctx.progress (stage, fraction) => boolean; false means "cancel" and is handed to the
 //                core's Progress sink, which stops with code Cancelled
 // Options use the names of the job's options schema (optionSchema below; a missing field means
@@ -21,6 +22,17 @@ export function meshInSlot(ctx, slot = defaultSlot) {
   const mesh = ctx.state.meshes?.get(slot);
   if (!mesh) throw new MeshMorphError('InvalidArgument', `no mesh is loaded${slot === defaultSlot ? '' : ` in slot '${slot}'`}; load a file first`);
   return mesh;
+}
+
+// A mesh slot whose weldedPositions / weldedIndices are copied out of the module's asset on
+// first read (module.assetWeldedMesh) and then kept: loading a mesh only to view it never pays
+// for them (at 1M vertices, 56 MB and a tenth of the load). Assigning them (a cut replaces the
+// mesh) works as on a plain object.
+function weldedMeshSlot(module, slot) {
+  let welded = null;
+  const fetch = () => (welded ??= { ...unwrap(module.assetWeldedMesh(slot.asset)) });
+  const field = (key) => ({ get: () => fetch()[key], set: (value) => { fetch()[key] = value; }, enumerable: true });
+  return Object.defineProperties(slot, { weldedPositions: field('positions'), weldedIndices: field('indices') });
 }
 
 function toBytes(value) {
@@ -53,14 +65,13 @@ export const ops = {
     ctx.state.meshes ??= new Map();
     const previous = ctx.state.meshes.get(slot);
     if (previous) ctx.module.disposeAsset(previous.asset);
-    ctx.state.meshes.set(slot, {
+    ctx.state.meshes.set(slot, weldedMeshSlot(ctx.module, {
       asset: r.asset,
       name: r.name,
       format: r.format,
-      weldedPositions: r.weldedPositions,
-      weldedIndices: r.weldedIndices,
+      weldedVertices: r.weldedVertices,
       toWelded: r.toWelded,
-    });
+    }));
     return {
       buffers: { positions: r.positions, indices: r.indices, normals: r.normals, toWelded: r.toWelded.slice() },
       info: {
@@ -73,7 +84,7 @@ export const ops = {
         text: r.text,
         infoReport: r.info, // the `meshmorph info --json` object
         rawVertices: r.positions.length / 3,
-        weldedVertices: r.weldedPositions.length / 3,
+        weldedVertices: r.weldedVertices,
       },
     };
   },
