@@ -1369,6 +1369,10 @@ it('no console warnings or errors during the run', async ({ allConsole }) => {
 
 // The tests that also run in Firefox (by name prefix).
 const firefoxTests = ['page loads', 'the default sample mesh renders', 'glTF materials', 'edit: ', 'transfer: ', 'transfer parts: ', 'retarget: ', 'merge: ', 'no console'];
+// Left to Chromium (CI time, eleventh session): the longest Firefox case (~21 s), whose controls
+// and worker ops the other Firefox retarget cases (Knight → Barbarian, Fox → wolf with automatic
+// joints and a pin, the person's own files) already drive.
+const firefoxSkip = ['retarget: KayKit clip onto the bundled human woman'];
 
 // Installed in every page before its own scripts: the long-task observer (Chromium) and a
 // drop helper that dispatches dragenter / dragover / drop with a file at a fraction of the
@@ -1494,7 +1498,7 @@ async function main() {
     } else if (missing) {
       console.log(`skip [firefox] all Firefox tests: ${missing}`);
     } else {
-      const selected = tests.filter((t) => firefoxTests.some((prefix) => t.name.startsWith(prefix)) && (!only || t.name.includes(only) || t.name.startsWith('no console')));
+      const selected = tests.filter((t) => firefoxTests.some((prefix) => t.name.startsWith(prefix)) && !firefoxSkip.some((prefix) => t.name.startsWith(prefix)) && (!only || t.name.includes(only) || t.name.startsWith('no console')));
       const ff = await runInFirefox({ tests: selected, baseUrl, initScripts: [pageHelpers], shotDir });
       console.log(`firefox ${ff.version}: ${ff.passed} passed, ${ff.failed} failed`);
       passed += ff.passed;
