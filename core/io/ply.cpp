@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <string_view>
 
 #include "operators/operators.h"
@@ -134,40 +135,63 @@ class PlyDataReader {
   PlyDataReader(const uint8_t* data, size_t size, PlyEncoding enc)
       : data_(data), size_(size), enc_(enc) {}
 
+  // Small enough to inline into the element loop: the binary little-endian case (most files)
+  // decodes in place; ASCII and big-endian go through the out-of-line readers.
   bool read(PlyType t, double* v) {
-    if (enc_ == PlyEncoding::Ascii) {
-      while (pos_ < size_ && std::isspace(data_[pos_])) ++pos_;
-      const size_t b = pos_;
-      while (pos_ < size_ && !std::isspace(data_[pos_])) ++pos_;
-      if (pos_ == b) return false;
-      const std::string_view tok(reinterpret_cast<const char*>(data_) + b, pos_ - b);
-      if (!parse_double_token(tok, v)) {
-        bad_token_ = quote_input(tok);
-        return false;
+    if (enc_ == PlyEncoding::BinaryLittleEndian) {
+      const size_t n = ply_type_size(t);
+      if (size_ - pos_ < n) return false;
+      const uint8_t* p = data_ + pos_;
+      pos_ += n;
+      switch (t) {
+        case PlyType::Int8: *v = static_cast<int8_t>(p[0]); return true;
+        case PlyType::UInt8: *v = p[0]; return true;
+        case PlyType::Int16: { int16_t x; std::memcpy(&x, p, 2); *v = x; return true; }
+        case PlyType::UInt16: { uint16_t x; std::memcpy(&x, p, 2); *v = x; return true; }
+        case PlyType::Int32: { int32_t x; std::memcpy(&x, p, 4); *v = x; return true; }
+        case PlyType::UInt32: { uint32_t x; std::memcpy(&x, p, 4); *v = x; return true; }
+        case PlyType::Float32: { float x; std::memcpy(&x, p, 4); *v = x; return true; }
+        case PlyType::Float64: { std::memcpy(v, p, 8); return true; }
       }
-      // An integer property holds an integer of its type's range (binary data cannot do otherwise).
-      if (ply_is_integer_type(t)) {
-        double lo, hi;
-        ply_integer_range(t, &lo, &hi);
-        if (!(*v >= lo && *v <= hi && *v == std::floor(*v))) {
-          bad_token_ = quote_input(tok);
-          bad_kind_ = " is not an integer of the property's type";
-          return false;
-        }
-      }
-      return true;
+      return false;
     }
-    const size_t n = ply_type_size(t);
-    if (size_ - pos_ < n) return false;
-    *v = ply_decode(data_ + pos_, t, enc_ == PlyEncoding::BinaryBigEndian);
-    pos_ += n;
-    return true;
+    return enc_ == PlyEncoding::Ascii ? read_ascii(t, v) : read_big_endian(t, v);
   }
   size_t remaining() const { return size_ - pos_; }
   const std::string& bad_token() const { return bad_token_; }
   const std::string& bad_kind() const { return bad_kind_; }
 
  private:
+  bool read_ascii(PlyType t, double* v) {
+    while (pos_ < size_ && std::isspace(data_[pos_])) ++pos_;
+    const size_t b = pos_;
+    while (pos_ < size_ && !std::isspace(data_[pos_])) ++pos_;
+    if (pos_ == b) return false;
+    const std::string_view tok(reinterpret_cast<const char*>(data_) + b, pos_ - b);
+    if (!parse_double_token(tok, v)) {
+      bad_token_ = quote_input(tok);
+      return false;
+    }
+    // An integer property holds an integer of its type's range (binary data cannot do otherwise).
+    if (ply_is_integer_type(t)) {
+      double lo, hi;
+      ply_integer_range(t, &lo, &hi);
+      if (!(*v >= lo && *v <= hi && *v == std::floor(*v))) {
+        bad_token_ = quote_input(tok);
+        bad_kind_ = " is not an integer of the property's type";
+        return false;
+      }
+    }
+    return true;
+  }
+  bool read_big_endian(PlyType t, double* v) {
+    const size_t n = ply_type_size(t);
+    if (size_ - pos_ < n) return false;
+    *v = ply_decode(data_ + pos_, t, true);
+    pos_ += n;
+    return true;
+  }
+
   const uint8_t* data_;
   size_t size_;
   PlyEncoding enc_;
@@ -311,7 +335,6 @@ Status load_ply(const std::vector<uint8_t>& bytes, Asset* asset) {
   for (int r = 0; r < nv; ++r)
     asset->V_raw.row(r) << ve.properties[px].values[r], ve.properties[py].values[r], ve.properties[pz].values[r];
 
-  std::vector<int> tri;
   if (doc->face_element >= 0) {
     const PlyElement& fe = doc->elements[doc->face_element];
     doc->face_list = fe.find("vertex_indices");
@@ -319,7 +342,8 @@ Status load_ply(const std::vector<uint8_t>& bytes, Asset* asset) {
     if (doc->face_list < 0 || !fe.properties[doc->face_list].is_list)
       return fail(StatusCode::ParseError, "PLY 'face' element needs a list property 'vertex_indices'");
     const PlyProperty& L = fe.properties[doc->face_list];
-    tri.reserve(fe.count * 3);
+    // Checked and counted first, then written straight into F_raw (fans of polygons).
+    size_t triangles = 0;
     for (size_t f = 0; f < fe.count; ++f) {
       const uint32_t b = L.offsets[f], n = L.offsets[f + 1] - b;
       if (n < 3)
@@ -332,16 +356,22 @@ Status load_ply(const std::vector<uint8_t>& bytes, Asset* asset) {
                                                   format_double(idx) + " but there are " + std::to_string(nv) +
                                                   " vertices");
       }
-      for (uint32_t k = 1; k + 1 < n; ++k) {
-        tri.push_back(static_cast<int>(L.values[b]));
-        tri.push_back(static_cast<int>(L.values[b + k]));
-        tri.push_back(static_cast<int>(L.values[b + k + 1]));
-      }
+      triangles += n - 2;
     }
+    if (triangles > static_cast<size_t>(std::numeric_limits<int>::max()))
+      return fail(StatusCode::Unsupported, "PLY file has more than 2^31 triangles");
+    Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> T(static_cast<Eigen::Index>(triangles), 3);
+    Eigen::Index t = 0;
+    for (size_t f = 0; f < fe.count; ++f) {
+      const uint32_t b = L.offsets[f], n = L.offsets[f + 1] - b;
+      for (uint32_t k = 1; k + 1 < n; ++k, ++t)
+        T.row(t) << static_cast<int>(L.values[b]), static_cast<int>(L.values[b + k]), static_cast<int>(L.values[b + k + 1]);
+    }
+    asset->F_raw = T;
   } else {
     asset->warnings.push_back("PLY file has no 'face' element (point cloud)");
+    asset->F_raw.resize(0, 3);
   }
-  asset->F_raw = Eigen::Map<Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>>(tri.data(), tri.size() / 3, 3);
   asset->document = std::move(doc);
   return Status::success();
 }
