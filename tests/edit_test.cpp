@@ -667,9 +667,20 @@ TEST(Edit, SupernodalCholeskyMatchesSimplicial) {
   ASSERT_TRUE(ref.solve(B, &Xr).ok());
   EXPECT_LE((X - Xr).cwiseAbs().maxCoeff(), 1e-8 * Xr.cwiseAbs().maxCoeff());
   EXPECT_LE((A * X - B).cwiseAbs().maxCoeff(), 1e-8 * B.cwiseAbs().maxCoeff());
-  // Indefinite: flip one diagonal entry far negative.
+  // Two threads (the tree's subtrees shared out, forced on this small system): the same factor
+  // bit for bit (natively; the wasm build has one thread and takes the sequential path).
+  SupernodalCholesky sn2;
+  sn2.parallel_min_flops = 0;
+  set_max_threads(2);
+  ASSERT_TRUE(sn2.factor(A).ok());
+  Eigen::MatrixXd X2;
+  ASSERT_TRUE(sn2.solve(B, &X2).ok());
+  EXPECT_TRUE(X2 == X);
+  // Indefinite: flip one diagonal entry far negative (on either path).
   SparseMatrix Bad = A;
   Bad.coeffRef(7, 7) = -1.0;
+  EXPECT_EQ(sn2.factor(Bad).code, StatusCode::FactorizationFailed);
+  set_max_threads(0);
   EXPECT_EQ(sn.factor(Bad).code, StatusCode::FactorizationFailed);
   // Singular: the pure Laplacian has constants in its null space.
   EXPECT_EQ(sn.factor(SparseMatrix(W.transpose()) * W).code, StatusCode::FactorizationFailed);

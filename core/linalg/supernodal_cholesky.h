@@ -30,6 +30,11 @@ class SupernodalCholesky {
   // gave 5× the fill on these matrices.)
   Status factor(const Eigen::SparseMatrix<double>& A, const Progress& progress = {});
 
+  // Natively, with max_threads() > 1, factorizations of at least this many flops (Σ ncols·m² over
+  // the supernodes) share the elimination tree's lower subtrees between two threads; the factor is
+  // bit-identical either way.
+  double parallel_min_flops = 5e8;
+
   bool factored() const { return factored_; }
   int size() const { return n_; }
   long factor_entries() const { return static_cast<long>(values_.size()); }  // stored (dense) entries of L
