@@ -4,7 +4,9 @@
 #include <cassert>
 #include <cmath>
 #include <string>
+#include <thread>
 
+#include "common/threads.h"
 #include "linalg/iterative_refinement.h"
 #include "mesh/topology.h"
 
@@ -192,50 +194,88 @@ Status LaplacianEditor::Impl::build_similarity_system(EditBuild& s, const Progre
   // needed: right-hand sides are residuals of the unsquared system.) Only rows j ≥ i are summed:
   // the Y_a lists and E's rows are sorted, so each starts at the diagonal (binary search); every
   // kept entry sums the same terms in the same order as the full column would.
-  EditSparse NUU(nU, nU);
-  NUU.reserve(static_cast<Eigen::Index>(nU) * 40);
-  std::vector<double> acc(nL, 0.0);
-  std::fill(mark.begin(), mark.end(), -1);
-  for (int i = 0; i < nU; ++i) {
-    touched.clear();
-    auto add = [&](int j, double v) {
-      if (mark[j] != i) {
-        mark[j] = i;
-        touched.push_back(j);
-        acc[j] = 0.0;
+  // Columns [c0, c1) into CSC pieces (row indices and values per column, ascending). The
+  // columns are independent: natively, with a second thread, the two halves of the unknowns
+  // (split where half of the reverse-index entries lie) are summed at once, each with its own
+  // accumulator; every entry sums the same terms in the same order either way.
+  struct Columns {
+    std::vector<int> ptr{0}, rows;
+    std::vector<double> vals;
+  };
+  const int* e_cols = Erow.innerIndexPtr();
+  const double* e_vals = Erow.valuePtr();
+  auto sum_columns = [&](int c0, int c1, Columns* out) {
+    std::vector<double> acc(nL, 0.0);
+    std::vector<int> seen(nL, -1), cols_touched;
+    out->rows.reserve(static_cast<size_t>(c1 - c0) * 40);
+    out->vals.reserve(static_cast<size_t>(c1 - c0) * 40);
+    for (int i = c0; i < c1; ++i) {
+      cols_touched.clear();
+      auto add = [&](int j, double v) {
+        if (seen[j] != i) {
+          seen[j] = i;
+          cols_touched.push_back(j);
+          acc[j] = 0.0;
+        }
+        acc[j] += v;
+      };
+      for (int k = rev_ptr[i]; k < rev_ptr[i + 1]; ++k) {
+        const int p = rev_center[k], e = rev_entry[k];
+        const double s0 = grads.weights(e, 0), s1 = grads.weights(e, 1), s2 = grads.weights(e, 2);
+        const int* y_begin = y_idx.data() + y_ptr[p];
+        const int* y_end = y_idx.data() + y_ptr[p + 1];
+        for (const int* y = std::lower_bound(y_begin, y_end, i); y != y_end; ++y) {
+          const size_t q = static_cast<size_t>(y - y_idx.data());
+          add(*y, s0 * y_val[3 * q] + s1 * y_val[3 * q + 1] + s2 * y_val[3 * q + 2]);
+        }
+        if (grad_row[p]) {
+          const int c = center_index[pair_centers[p]];
+          for (int f = grads.offsets[c]; f < grads.offsets[c + 1]; ++f)
+            if (stencil_local[f] >= i)
+              add(stencil_local[f], wg * (s0 * grads.weights(f, 0) + s1 * grads.weights(f, 1) + s2 * grads.weights(f, 2)));
+        }
       }
-      acc[j] += v;
-    };
-    for (int k = rev_ptr[i]; k < rev_ptr[i + 1]; ++k) {
-      const int p = rev_center[k], e = rev_entry[k];
-      const double s0 = grads.weights(e, 0), s1 = grads.weights(e, 1), s2 = grads.weights(e, 2);
-      const int* y_begin = y_idx.data() + y_ptr[p];
-      const int* y_end = y_idx.data() + y_ptr[p + 1];
-      for (const int* y = std::lower_bound(y_begin, y_end, i); y != y_end; ++y) {
-        const size_t q = static_cast<size_t>(y - y_idx.data());
-        add(*y, s0 * y_val[3 * q] + s1 * y_val[3 * q + 1] + s2 * y_val[3 * q + 2]);
+      for (EditSparse::InnerIterator er(Ecol, i); er; ++er) {
+        const int* row_end = e_cols + Erow.outerIndexPtr()[er.row() + 1];
+        for (const int* c = std::lower_bound(e_cols + Erow.outerIndexPtr()[er.row()], row_end, i); c != row_end; ++c)
+          add(*c, er.value() * e_vals[c - e_cols]);
       }
-      if (grad_row[p]) {
-        const int c = center_index[pair_centers[p]];
-        for (int f = grads.offsets[c]; f < grads.offsets[c + 1]; ++f)
-          if (stencil_local[f] >= i)
-            add(stencil_local[f], wg * (s0 * grads.weights(f, 0) + s1 * grads.weights(f, 1) + s2 * grads.weights(f, 2)));
-      }
+      if (soft[i] > 0) add(i, soft[i]);
+      std::sort(cols_touched.begin(), cols_touched.end());
+      for (int j : cols_touched)
+        if (j < nU) out->rows.push_back(j), out->vals.push_back(acc[j]);
+      out->ptr.push_back(static_cast<int>(out->rows.size()));
     }
-    const int* e_cols = Erow.innerIndexPtr();
-    const double* e_vals = Erow.valuePtr();
-    for (EditSparse::InnerIterator er(Ecol, i); er; ++er) {
-      const int* row_end = e_cols + Erow.outerIndexPtr()[er.row() + 1];
-      for (const int* c = std::lower_bound(e_cols + Erow.outerIndexPtr()[er.row()], row_end, i); c != row_end; ++c)
-        add(*c, er.value() * e_vals[c - e_cols]);
-    }
-    if (soft[i] > 0) add(i, soft[i]);
-    std::sort(touched.begin(), touched.end());
-    NUU.startVec(i);
-    for (int j : touched)
-      if (j < nU) NUU.insertBack(j, i) = acc[j];
+  };
+  Columns halves[2];
+  int mid = nU;
+#if !defined(__EMSCRIPTEN__)
+  if (max_threads() > 1 && nU >= 2000) {
+    mid = static_cast<int>(std::lower_bound(rev_ptr.begin(), rev_ptr.begin() + nU + 1, rev_ptr[nU] / 2) - rev_ptr.begin());
+    mid = std::clamp(mid, 1, nU - 1);
+    std::thread second(sum_columns, mid, nU, &halves[1]);
+    sum_columns(0, mid, &halves[0]);
+    second.join();
   }
-  NUU.finalize();
+#endif
+  if (mid == nU) sum_columns(0, nU, &halves[0]);
+  const size_t nnz = halves[0].rows.size() + halves[1].rows.size();
+  EditSparse NUU(nU, nU);
+  NUU.resizeNonZeros(static_cast<Eigen::Index>(nnz));
+  {
+    int* outer = NUU.outerIndexPtr();
+    int col = 0;
+    int base = 0;
+    size_t at = 0;
+    for (const Columns& h : halves) {
+      for (size_t k = 0; k + 1 < h.ptr.size(); ++k) outer[col++] = base + h.ptr[k];
+      std::copy(h.rows.begin(), h.rows.end(), NUU.innerIndexPtr() + at);
+      std::copy(h.vals.begin(), h.vals.end(), NUU.valuePtr() + at);
+      at += h.rows.size();
+      base += static_cast<int>(h.rows.size());
+    }
+    outer[nU] = static_cast<int>(nnz);
+  }
   E1 = std::move(E);
 
   stats.system_nonzeros = static_cast<long>(NUU.nonZeros());
