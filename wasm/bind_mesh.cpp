@@ -232,22 +232,27 @@ val load_asset_js(const val& bytes_js, const std::string& name, const val& files
 
 bool dispose_asset_js(int id) { return asset_registry().erase(id) > 0; }
 
-val asset_welded_mesh_js(int id) {
+// The registered asset with this id, or null (the caller returns unknown_asset(id)).
+const io::Asset* find_asset(int id) {
   const auto it = asset_registry().find(id);
-  if (it == asset_registry().end())
-    return error_object(StatusCode::InvalidArgument, "no loaded asset with id " + std::to_string(id));
+  return it == asset_registry().end() ? nullptr : it->second.get();
+}
+val unknown_asset(int id) { return error_object(StatusCode::InvalidArgument, "no loaded asset with id " + std::to_string(id)); }
+
+val asset_welded_mesh_js(int id) {
+  const io::Asset* found = find_asset(id);
+  if (!found) return unknown_asset(id);
   val o = status_object(Status::success());
-  o.set("positions", to_float64_array(it->second->weld.V));
-  o.set("indices", to_uint32_array(it->second->weld.F));
+  o.set("positions", to_float64_array(found->weld.V));
+  o.set("indices", to_uint32_array(found->weld.F));
   return o;
 }
 
 val export_asset_js(int id, const val& positions, const std::string& format_name,
                     const val& options) {
-  const auto it = asset_registry().find(id);
-  if (it == asset_registry().end())
-    return error_object(StatusCode::InvalidArgument, "no loaded asset with id " + std::to_string(id));
-  const io::Asset& asset = *it->second;
+  const io::Asset* found = find_asset(id);
+  if (!found) return unknown_asset(id);
+  const io::Asset& asset = *found;
   const std::optional<io::Format> format = parse_format(format_name.empty() ? "glb" : format_name);
   if (!format) return error_object(StatusCode::InvalidArgument, "unknown export format '" + format_name + "'");
 
@@ -271,14 +276,13 @@ val export_asset_js(int id, const val& positions, const std::string& format_name
 
 // A new mesh in place of the asset's geometry (merge and cut results), keeping its document.
 val export_asset_with_mesh_js(int id, const val& positions, const val& indices, const std::string& format_name) {
-  const auto it = asset_registry().find(id);
-  if (it == asset_registry().end())
-    return error_object(StatusCode::InvalidArgument, "no loaded asset with id " + std::to_string(id));
+  const io::Asset* found = find_asset(id);
+  if (!found) return unknown_asset(id);
   const std::optional<io::Format> format = parse_format(format_name.empty() ? "glb" : format_name);
   if (!format) return error_object(StatusCode::InvalidArgument, "unknown export format '" + format_name + "'");
   std::vector<uint8_t> bytes;
   const Status s =
-      io::save_asset_with_mesh_to_memory(*it->second, to_matrix(positions), to_index_matrix(indices), *format, &bytes);
+      io::save_asset_with_mesh_to_memory(*found, to_matrix(positions), to_index_matrix(indices), *format, &bytes);
   val o = status_object(s);
   if (s.ok()) o.set("bytes", to_uint8_array(bytes));
   return o;

@@ -295,12 +295,11 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
   // ranges are contiguous) shared out by work between this thread and a second one; the
   // supernodes above them follow here. Measured on the 48k-unknown Eq. 7 system of michael3:
   // 26 % of the flops above the cut, 37 / 37 % below.
-#if defined(__EMSCRIPTEN__)
-  const bool parallel = false;  // built without threads
-#else
-  const bool parallel = max_threads() > 1 && total_flops >= parallel_min_flops;
-#endif
-  if (parallel) {
+  // (The wasm build has no threads: it always takes the sequential path.)
+  bool split = false;
+#if !defined(__EMSCRIPTEN__)
+  if (max_threads() > 1 && total_flops >= parallel_min_flops) {
+    split = true;
     std::vector<int> snp(ns, -1), first(ns);
     std::vector<double> sub(ns, 0.0);
     for (int s = 0; s < ns; ++s) {
@@ -344,18 +343,17 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     };
     Scratch worker_scratch{std::vector<int>(n, -1), {}};
     Status main_status = Status::success();
-#if !defined(__EMSCRIPTEN__)
     std::thread worker(run, std::cref(bins[1]), std::ref(worker_scratch), &worker_status);
     run(bins[0], main_scratch, &main_status);
     worker.join();
-#endif
     if (!main_status.ok()) return main_status;
     if (!worker_status.ok()) return worker_status;
-    if (stop) return Status::error(StatusCode::FactorizationFailed, "system matrix is singular or not positive definite");
     done_flops = load[0] + load[1];
     for (int s = 0; s < ns; ++s)
       if (top[s]) sequence.push_back(s);
-  } else {
+  }
+#endif
+  if (!split) {
     sequence.resize(ns);
     for (int s = 0; s < ns; ++s) sequence[s] = s;
   }
