@@ -1,17 +1,11 @@
-// Joins the native and wasm rows of meshmorph_bench --json into one Markdown table. With a third
-// file (the native run with --threads N, scripts/bench --threads N), the native column is the
-// one-thread run and a column for N threads follows.
+// Joins the rows of meshmorph_bench --json runs into one Markdown table:
+//   node scripts/bench-table.mjs NATIVE.json WASM.json [--native-threads F.json] [--wasm-threads F.json]
+// NATIVE and WASM are one-thread runs (the single-threaded wasm build); the optional files are the
+// native run with --threads N and the threaded wasm build's run with --threads N (scripts/bench
+// --threads N). wasm/native compares one thread with one thread; wasm N/native 1 is the figure the
+// browser gets against the single-threaded native build.
 import { readFileSync } from 'node:fs';
 
-const [nativePath, wasmPath, threadedPath] = process.argv.slice(2);
-const native = JSON.parse(readFileSync(nativePath, 'utf8'));
-const wasm = JSON.parse(readFileSync(wasmPath, 'utf8'));
-const threaded = threadedPath ? JSON.parse(readFileSync(threadedPath, 'utf8')) : null;
-const key = (r) => `${r.suite}|${r.mesh}|${r.stage}`;
-const wasmByKey = new Map(wasm.map((r) => [key(r), r]));
-const threadedByKey = new Map((threaded || []).map((r) => [key(r), r]));
-const n = threaded?.[0]?.threads ?? 0;
-const fmt = (ms) => (ms >= 1000 ? `${(ms / 1000).toFixed(2)} s` : `${ms.toFixed(ms < 10 ? 2 : 1)} ms`);
 // The peer's time in ms from its figure ("igl 8 ms", "Spectra+LDLT 1.56 s", "paper 001: 0.062 +
 // 0.328 + 0.032 s" → the sum), or null when the figure has no time.
 export function peerMs(text) {
@@ -21,16 +15,49 @@ export function peerMs(text) {
   return m[2] === 's' ? total * 1000 : total;
 }
 
-const nativeHead = threaded ? `native (1 thread) | native (${n} threads)` : 'native';
-console.log(`| suite | mesh | #V | stage | ${nativeHead} | wasm | wasm/native | peer (PEERS.md / paper) | native/peer | note |`);
-console.log(`|---|---|---|---|---|${threaded ? '---|' : ''}---|---|---|---|---|`);
-for (const r of native) {
-  const w = wasmByKey.get(key(r));
-  const t = threadedByKey.get(key(r));
-  const ratio = w && r.ms > 0 ? (w.ms / r.ms).toFixed(2) : '—';
-  const p = peerMs(r.peer);
-  const best = t && t.ms < r.ms ? t.ms : r.ms;  // native/peer: the faster native run
-  const vsPeer = p && best > 0 ? (best / p).toFixed(2) : '';
-  const threadedCell = threaded ? ` ${t ? fmt(t.ms) : '—'} |` : '';
-  console.log(`| ${r.suite} | ${r.mesh} | ${r.vertices} | ${r.stage} | ${fmt(r.ms)} |${threadedCell} ${w ? fmt(w.ms) : '—'} | ${ratio} | ${r.peer} | ${vsPeer} | ${r.note} |`);
+function main(argv) {
+  const positional = [];
+  const named = {};
+  for (let i = 0; i < argv.length; ++i) {
+    if (argv[i].startsWith('--')) named[argv[i].slice(2)] = argv[++i];
+    else positional.push(argv[i]);
+  }
+  const read = (f) => (f ? JSON.parse(readFileSync(f, 'utf8')) : null);
+  const [native, wasm] = positional.map(read);
+  const nativeN = read(named['native-threads']);
+  const wasmN = read(named['wasm-threads']);
+  const key = (r) => `${r.suite}|${r.mesh}|${r.stage}`;
+  const index = (rows) => new Map((rows || []).map((r) => [key(r), r]));
+  const [wasmBy, nativeNBy, wasmNBy] = [index(wasm), index(nativeN), index(wasmN)];
+  const n = nativeN?.[0]?.threads ?? wasmN?.[0]?.threads ?? 0;
+  const fmt = (ms) => (ms >= 1000 ? `${(ms / 1000).toFixed(2)} s` : `${ms.toFixed(ms < 10 ? 2 : 1)} ms`);
+  const cell = (r) => (r ? fmt(r.ms) : '—');
+  const ratio = (a, b) => (a && b && b.ms > 0 ? (a.ms / b.ms).toFixed(2) : '—');
+
+  const head = ['suite', 'mesh', '#V', 'stage', 'native (1 thread)'];
+  if (nativeN) head.push(`native (${n} threads)`);
+  head.push('wasm (1 thread)');
+  if (wasmN) head.push(`wasm (${n} threads)`);
+  head.push('wasm/native');
+  if (wasmN) head.push(`wasm ${n}/native 1`);
+  head.push('peer (PEERS.md / paper)', 'native/peer', 'note');
+  console.log(`| ${head.join(' | ')} |`);
+  console.log(`|${head.map(() => '---').join('|')}|`);
+  for (const r of native) {
+    const w = wasmBy.get(key(r));
+    const t = nativeNBy.get(key(r));
+    const wt = wasmNBy.get(key(r));
+    const p = peerMs(r.peer);
+    const best = t && t.ms < r.ms ? t.ms : r.ms;  // native/peer: the faster native run
+    const row = [r.suite, r.mesh, r.vertices, r.stage, fmt(r.ms)];
+    if (nativeN) row.push(cell(t));
+    row.push(cell(w));
+    if (wasmN) row.push(cell(wt));
+    row.push(ratio(w, r));
+    if (wasmN) row.push(ratio(wt, r));
+    row.push(r.peer, p && best > 0 ? (best / p).toFixed(2) : '', r.note);
+    console.log(`| ${row.join(' | ')} |`);
+  }
 }
+
+if (import.meta.url === `file://${process.argv[1]}`) main(process.argv.slice(2));

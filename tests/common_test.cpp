@@ -1,9 +1,15 @@
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
+#include <numeric>
+#include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "common/progress.h"
 #include "common/status.h"
+#include "common/threads.h"
 
 namespace mm {
 
@@ -54,6 +60,92 @@ TEST(Progress, FractionIsClamped) {
   EXPECT_EQ(last, 1.0);
   p.update("x", -1.0);
   EXPECT_EQ(last, 0.0);
+}
+
+// ---- tasks (common/threads.h). Also run in wasm: with -pthread (the JS tests' threaded module
+// drives the same pool through the ops) and without (every task runs in wait()).
+
+// Restores the default thread count when a test ends.
+struct ThreadCount {
+  explicit ThreadCount(int n) { set_max_threads(n); }
+  ~ThreadCount() { set_max_threads(0); }
+};
+
+TEST(Tasks, OneThreadRunsTheWorkInWaitOnTheCallingThread) {
+  ThreadCount one(1);
+  const std::thread::id me = std::this_thread::get_id();
+  std::thread::id ran;
+  bool done = false;
+  Task t([&] { ran = std::this_thread::get_id(), done = true; });
+  EXPECT_FALSE(done);  // deferred: nothing runs before wait()
+  t.wait();
+  EXPECT_TRUE(done);
+  EXPECT_EQ(ran, me);
+  EXPECT_FALSE(t.valid());
+}
+
+TEST(Tasks, ManyMoreTasksThanThreadsAllRunOnceAndNestedWaitsDoNotDeadlock) {
+  ThreadCount two(2);  // one pool thread at most: the nested tasks must be run by their owners
+  constexpr int kOuter = 16, kInner = 8;
+  std::vector<std::atomic<int>> runs(kOuter * (kInner + 1));
+  for (auto& r : runs) r = 0;
+  std::vector<Task> outer;
+  for (int i = 0; i < kOuter; ++i) {
+    outer.emplace_back([i, &runs] {
+      std::vector<Task> inner;
+      for (int j = 0; j < kInner; ++j) inner.emplace_back([i, j, &runs] { ++runs[i * (kInner + 1) + 1 + j]; });
+      ++runs[i * (kInner + 1)];
+      for (Task& t : inner) t.wait();
+    });
+  }
+  for (Task& t : outer) t.wait();
+  for (size_t k = 0; k < runs.size(); ++k) EXPECT_EQ(runs[k].load(), 1) << "piece " << k;
+}
+
+TEST(Tasks, WaitRethrowsTheWorksExceptionAndTheDestructorWaits) {
+  ThreadCount two(2);
+  Task bad([] { throw std::runtime_error("boom"); });
+  EXPECT_THROW(bad.wait(), std::runtime_error);
+  std::atomic<bool> finished{false};
+  {
+    Task slow([&] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      finished = true;
+    });
+  }  // the destructor waits
+  EXPECT_TRUE(finished.load());
+  // wait_for: false while a pool thread still runs the work, true once done.
+  std::atomic<bool> started{false}, release{false};
+  struct Release {  // a failed assertion below must not leave the destructor waiting forever
+    std::atomic<bool>& flag;
+    ~Release() { flag = true; }
+  };
+  Task held([&] {
+    started = true;
+    while (!release.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  });
+  const Release on_exit{release};  // destroyed before `held`
+  if (MM_HAS_THREADS) {  // (without threads the work runs in wait_for below, after the release)
+    for (int i = 0; i < 10000 && !started.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    ASSERT_TRUE(started.load()) << "no pool thread took the task within 10 s";
+    EXPECT_FALSE(held.wait_for(std::chrono::milliseconds(5)));
+  }
+  release = true;
+  EXPECT_TRUE(held.wait_for(std::chrono::milliseconds(5000)));
+}
+
+TEST(Tasks, TwoHalvesGiveTheSameSumAsOneLoop) {
+  std::vector<double> x(100000);
+  for (size_t i = 0; i < x.size(); ++i) x[i] = 1.0 / static_cast<double>(i + 1);
+  double one = 0, lo = 0, hi = 0;
+  one = std::accumulate(x.begin(), x.begin() + 50000, 0.0) + std::accumulate(x.begin() + 50000, x.end(), 0.0);
+  {
+    ThreadCount two(2);
+    Task upper([&] { hi = std::accumulate(x.begin() + 50000, x.end(), 0.0); });
+    lo = std::accumulate(x.begin(), x.begin() + 50000, 0.0);
+    upper.wait();
+  }
+  EXPECT_EQ(lo + hi, one);
 }
 
 }  // namespace mm

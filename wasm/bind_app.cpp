@@ -4,12 +4,16 @@
 // JS API:
 //   optionSchema(job: "edit" | "merge" | "transfer" | "retarget" | "joints")  (app/jobs.h)
 //     → {ok, schema: {job, summary, options: [{name, kind, default, min?, max?, choices?, flag, help}]}}
+//   threads() → {ok, threaded: bool (the -pthread build), maxThreads: n}   (common/threads.h)
+//   setMaxThreads(n: int) → the same object; n ≥ 1 caps the core's threads (1 = sequential,
+//     bit-identical results either way), n ≤ 0 restores the default (hardware concurrency)
 #include <string>
 
 #include <emscripten/bind.h>
 #include <emscripten/val.h>
 
 #include "app/jobs.h"
+#include "common/threads.h"
 #include "convert.h"
 #include "guard.h"
 
@@ -28,8 +32,24 @@ emscripten::val option_schema_js(const std::string& job) {
   return out;
 }
 
+emscripten::val threads_js() {
+  emscripten::val out = status_object(Status::success());
+  out.set("threaded", MM_HAS_THREADS == 1);
+  out.set("maxThreads", max_threads());
+  return out;
+}
+
+emscripten::val set_max_threads_js(int n) {
+  set_max_threads(n);
+  return threads_js();
+}
+
 }  // namespace
 
-EMSCRIPTEN_BINDINGS(meshmorph_app) { bind<&option_schema_js>("optionSchema"); }
+EMSCRIPTEN_BINDINGS(meshmorph_app) {
+  bind<&option_schema_js>("optionSchema");
+  bind<&threads_js>("threads");
+  bind<&set_max_threads_js>("setMaxThreads");
+}
 
 }  // namespace mm::wasm

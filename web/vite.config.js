@@ -6,8 +6,12 @@
 // - Gallery samples (web/src/lib/samples.js) and the Retarget job's characters and joints files
 //   (web/src/lib/clip-library.js) are served from data/ by the dev server and copied
 //   into the build under samples/, with data/licenses/.
-// - COOP/COEP headers make the page crossOriginIsolated, so SharedArrayBuffer exists and
-//   Cancel can stop a computation without killing the worker (see web/src/lib/client.js).
+// - The threaded wasm build (`meshmorph_web_mt.*` from build/wasm-mt/wasm, override with
+//   MM_WASM_MT_DIR) is served and copied as plain files under wasm-mt/: its pthread workers load
+//   the glue again by URL, so Vite must not bundle it. Missing, the page runs single-threaded.
+// - COOP/COEP headers make the page crossOriginIsolated, so SharedArrayBuffer exists (Cancel
+//   stops a computation without killing the worker, see web/src/lib/client.js, and the threaded
+//   module can share its memory).
 import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -19,6 +23,7 @@ const webDir = path.dirname(fileURLToPath(import.meta.url));
 const repoDir = path.resolve(webDir, '..');
 const dataDir = path.join(repoDir, 'data');
 const wasmDir = path.resolve(repoDir, process.env.MM_WASM_DIR || 'build/wasm/wasm');
+const wasmThreadedDir = path.resolve(repoDir, process.env.MM_WASM_MT_DIR || 'build/wasm-mt/wasm');
 
 const isolationHeaders = {
   'Cross-Origin-Opener-Policy': 'same-origin',
@@ -56,6 +61,34 @@ function meshmorphSamples() {
   };
 }
 
+const threadedFiles = ['meshmorph_web_mt.mjs', 'meshmorph_web_mt.wasm', 'meshmorph_web_mt.worker.js'];
+const threadedTypes = { '.mjs': 'text/javascript', '.js': 'text/javascript', '.wasm': 'application/wasm' };
+
+function meshmorphThreadedModule() {
+  const present = () => threadedFiles.every((f) => fs.existsSync(path.join(wasmThreadedDir, f)));
+  return {
+    name: 'meshmorph-threaded-module',
+    configureServer(server) {
+      server.middlewares.use('/wasm-mt/', (req, res, next) => {
+        const rel = decodeURIComponent((req.url || '').split('?')[0]).replace(/^\/+/, '');
+        if (!threadedFiles.includes(rel) || !fs.existsSync(path.join(wasmThreadedDir, rel))) return next();
+        for (const [k, v] of Object.entries(isolationHeaders)) res.setHeader(k, v);
+        res.setHeader('Content-Type', threadedTypes[path.extname(rel)]);
+        fs.createReadStream(path.join(wasmThreadedDir, rel)).pipe(res);
+      });
+    },
+    generateBundle() {
+      if (!present()) {
+        this.warn(`${wasmThreadedDir} has no threaded build (scripts/build wasm): the page will run on one thread`);
+        return;
+      }
+      for (const f of threadedFiles) {
+        this.emitFile({ type: 'asset', fileName: `wasm-mt/${f}`, source: fs.readFileSync(path.join(wasmThreadedDir, f)) });
+      }
+    },
+  };
+}
+
 // A missing wasm build otherwise surfaces as an obscure resolve error deep in the worker.
 function requireWasmBuild() {
   return {
@@ -75,7 +108,7 @@ export default defineConfig({
   base: './',
   publicDir: false,
   resolve: { alias: { '@meshmorph/wasm': wasmDir } },
-  plugins: [requireWasmBuild(), meshmorphSamples()],
+  plugins: [requireWasmBuild(), meshmorphSamples(), meshmorphThreadedModule()],
   worker: { format: 'es' },
   build: {
     outDir: path.join(repoDir, 'build/web-dist'),

@@ -1,8 +1,14 @@
 #include "common/threads.h"
 
+#include <algorithm>
 #include <atomic>
+#include <condition_variable>
 #include <cstdlib>
+#include <deque>
+#include <exception>
+#include <mutex>
 #include <thread>
+#include <vector>
 
 namespace mm {
 namespace {
@@ -10,14 +16,16 @@ namespace {
 std::atomic<int> g_override{0};
 
 int default_threads() {
-#if defined(__EMSCRIPTEN__)
+#if !MM_HAS_THREADS
   return 1;
 #else
+#if !defined(__EMSCRIPTEN__)
   if (const char* e = std::getenv("MM_THREADS")) {
     char* end = nullptr;
     const long n = std::strtol(e, &end, 10);
     if (end != e && *end == '\0' && n >= 1 && n <= 1024) return static_cast<int>(n);
   }
+#endif
   const unsigned hw = std::thread::hardware_concurrency();
   return hw >= 1 ? static_cast<int>(hw) : 1;
 #endif
@@ -27,7 +35,7 @@ int default_threads() {
 
 int max_threads() {
   static const int d = default_threads();
-#if defined(__EMSCRIPTEN__)
+#if !MM_HAS_THREADS
   return d;  // 1: no threads in this build, whatever was asked
 #else
   const int o = g_override.load();
@@ -36,5 +44,128 @@ int max_threads() {
 }
 
 void set_max_threads(int n) { g_override.store(n >= 1 ? n : 0); }
+
+// ---- tasks
+
+struct Task::State {
+  enum Phase { Queued, Running, Done };
+  std::function<void()> work;
+  Phase phase = Queued;
+  std::exception_ptr error;
+};
+
+namespace {
+
+// One pool per process, never destroyed (its threads wait on the condition variable until the
+// process ends). All task phases are guarded by its one mutex: tasks are few and coarse.
+struct Pool {
+  std::mutex mutex;
+  std::condition_variable work_ready;  // a task was queued
+  std::condition_variable task_done;   // some task finished
+  std::deque<std::shared_ptr<Task::State>> queue;
+  int threads = 0;  // started (never stopped)
+  int busy = 0;     // of which running a task: at most max_threads() − 1, whatever was started
+
+  static Pool& get() {
+    static Pool* pool = new Pool;  // leaked on purpose: see above
+    return *pool;
+  }
+
+  // Runs a task the caller has just marked Running (outside the lock).
+  void run(const std::shared_ptr<Task::State>& t) {
+    try {
+      t->work();
+    } catch (...) {
+      t->error = std::current_exception();
+    }
+    std::lock_guard<std::mutex> lock(mutex);
+    t->phase = Task::State::Done;
+    t->work = nullptr;
+    task_done.notify_all();
+  }
+
+#if MM_HAS_THREADS
+  void loop() {
+    std::unique_lock<std::mutex> lock(mutex);
+    for (;;) {
+      work_ready.wait(lock, [this] { return !queue.empty() && busy < std::min(max_threads() - 1, kMaxPoolThreads); });
+      std::shared_ptr<Task::State> t = std::move(queue.front());
+      queue.pop_front();
+      if (t->phase != Task::State::Queued) continue;  // its owner took it back
+      t->phase = Task::State::Running;
+      ++busy;
+      lock.unlock();
+      run(t);
+      lock.lock();
+      --busy;
+      if (!queue.empty()) work_ready.notify_one();
+    }
+  }
+
+  // Called with the mutex held: at most min(max_threads() − 1, kMaxPoolThreads) threads.
+  void grow_locked() {
+    const int wanted = std::min(max_threads() - 1, kMaxPoolThreads);
+    while (threads < wanted) {
+      std::thread(&Pool::loop, this).detach();
+      ++threads;
+    }
+  }
+#endif
+};
+
+}  // namespace
+
+Task::Task(std::function<void()> work) : state_(std::make_shared<State>()) {
+  state_->work = std::move(work);
+#if MM_HAS_THREADS
+  if (max_threads() > 1) {
+    Pool& pool = Pool::get();
+    std::lock_guard<std::mutex> lock(pool.mutex);
+    pool.grow_locked();
+    pool.queue.push_back(state_);
+    pool.work_ready.notify_one();
+  }
+#endif
+}
+
+Task& Task::operator=(Task&& other) noexcept {
+  if (this != &other) {
+    finish_quietly();
+    state_ = std::move(other.state_);
+  }
+  return *this;
+}
+
+Task::~Task() { finish_quietly(); }
+
+bool Task::wait_for(std::chrono::milliseconds timeout) {
+  if (!state_) return true;
+  Pool& pool = Pool::get();
+  std::unique_lock<std::mutex> lock(pool.mutex);
+  if (state_->phase == State::Queued) {
+    // No thread has started it: run it here (a queued copy is skipped by the pool).
+    state_->phase = State::Running;
+    lock.unlock();
+    pool.run(state_);
+    lock.lock();
+  }
+  if (!pool.task_done.wait_for(lock, timeout, [this] { return state_->phase == State::Done; })) return false;
+  std::exception_ptr error = state_->error;
+  state_.reset();
+  if (error) std::rethrow_exception(error);
+  return true;
+}
+
+void Task::wait() {
+  while (!wait_for(std::chrono::milliseconds(1000))) {
+  }
+}
+
+void Task::finish_quietly() noexcept {
+  try {
+    wait();
+  } catch (...) {
+  }
+}
 
 }  // namespace mm

@@ -1,17 +1,69 @@
-// How many threads the core may keep busy at once. Natively the core overlaps independent stages
-// on a second thread (the transfer's cage and mean-value coordinates beside the eigenbases, the
-// editor's Poisson factor beside the Eq. 7 factor); the results are bit-identical whatever the
-// count (each stage does the same arithmetic on either thread). WebAssembly is built without
-// threads: 1 there.
+// How many threads the core may keep busy at once, and the tasks it hands to other threads.
+//
+// The core overlaps independent stages (the transfer's cage and mean-value coordinates beside the
+// eigenbases, the editor's Poisson factor beside the Eq. 7 system) and splits a few loops in two
+// fixed halves (the Eq. 7 columns, the supernodal factor's subtrees, the mean-value rows). Each
+// piece does the same arithmetic whichever thread runs it, so results are bit-identical whatever
+// the thread count.
+//
+// Where threads exist: natively, and in the wasm build with -pthread (MM_WASM_THREADS, the page's
+// module when crossOriginIsolated). The single-threaded wasm build compiles the threaded paths out
+// (MM_HAS_THREADS = 0) and max_threads() is 1 there. Only the calling thread reports progress: in
+// wasm the progress sink calls JavaScript, which lives on that thread alone.
+//
+// Tasks run on a small pool of long-lived threads, not on a thread per task: in wasm a finished
+// pthread's Worker only returns to Emscripten's pool when the calling thread's event loop turns,
+// which never happens inside one computation, so threads started per task would exhaust the pool
+// within one op and the next start would wait forever.
 #pragma once
+
+#include <chrono>
+#include <functional>
+#include <memory>
+
+#if !defined(__EMSCRIPTEN__) || defined(__EMSCRIPTEN_PTHREADS__)
+#define MM_HAS_THREADS 1
+#else
+#define MM_HAS_THREADS 0
+#endif
 
 namespace mm {
 
-// Default: MM_THREADS from the environment when it is a positive integer, else the hardware's
-// concurrency (at least 1).
+// Default: MM_THREADS from the environment when it is a positive integer (natively), else the
+// hardware's concurrency (navigator.hardwareConcurrency / node's CPU count in wasm), at least 1.
+// Always 1 without threads.
 int max_threads();
-// n ≥ 1 overrides the default (the bench's --threads); n ≤ 0 goes back to it. Not meant to be
-// changed while a computation runs.
+// n ≥ 1 overrides the default (the bench's --threads, the wasm binding setMaxThreads); n ≤ 0
+// goes back to it. Not meant to be changed while a computation runs.
 void set_max_threads(int n);
+
+// Most pool threads ever started (the wasm build's PTHREAD_POOL_SIZE must be at least this): the
+// core never has more than three pieces of work in flight besides the caller's own.
+constexpr int kMaxPoolThreads = 3;
+
+// A piece of work handed to the pool. It runs on a pool thread if one takes it before the owner
+// waits; otherwise the owner runs it itself in wait() (so a busy or empty pool, or a task started
+// from a pool thread, never deadlocks). With max_threads() = 1 it is always run in wait().
+// Exceptions from the work are rethrown by wait(). The destructor waits (without rethrowing).
+class Task {
+ public:
+  Task() = default;
+  explicit Task(std::function<void()> work);
+  Task(Task&&) noexcept = default;
+  Task& operator=(Task&& other) noexcept;
+  ~Task();
+
+  bool valid() const { return state_ != nullptr; }
+  // Waits until the work is done (running it here if no thread has started it).
+  void wait();
+  // Like wait(), but returns false after `timeout` if a pool thread is still running the work.
+  bool wait_for(std::chrono::milliseconds timeout);
+
+  struct State;
+
+ private:
+  void finish_quietly() noexcept;
+  std::shared_ptr<State> state_;
+};
 
 }  // namespace mm

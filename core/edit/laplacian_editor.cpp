@@ -3,7 +3,6 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
-#include <future>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -99,22 +98,25 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
   // natively, with a second thread, the Poisson factor is built beside the Eq. 7 assembly and
   // factor (it reads the region and V, writes only its own members; no progress from that
   // thread). Bit-identical either way.
-  std::future<Status> poisson;
-#if !defined(__EMSCRIPTEN__)
+  Status poisson_status = Status::success();
+  Task poisson;  // declared after poisson_status: an early return waits for it first
+#if MM_HAS_THREADS
   if (s.implicit && max_threads() > 1)
-    poisson = std::async(std::launch::async, [this, &s] { return build_finalize_system(s, Progress{}); });
+    poisson = Task([this, &s, &poisson_status] { poisson_status = build_finalize_system(s, Progress{}); });
 #endif
   if (!poisson.valid())
     if (Status st = build_finalize_system(s, progress); !st.ok()) return st;
   if (!progress.update("edit: assembling", 0.1)) return cancelled_status("edit: assembling");
   if (s.implicit) {
-    // An early return waits for the Poisson thread (the future's destructor).
+    // An early return waits for the Poisson task (its destructor).
     if (Status st = build_similarity_system(s, progress); !st.ok()) return st;
     if (opt.handle_basis)
       if (Status st = build_handle_basis(s, progress); !st.ok()) return st;
   }
-  if (poisson.valid())
-    if (Status st = poisson.get(); !st.ok()) return st;
+  if (poisson.valid()) {
+    poisson.wait();
+    if (!poisson_status.ok()) return poisson_status;
+  }
   if (!progress.update("edit: done", 1.0)) return cancelled_status("edit: done");
   ready = true;
   return Status::success();

@@ -4,7 +4,6 @@
 #include <cassert>
 #include <cmath>
 #include <string>
-#include <thread>
 
 #include "common/threads.h"
 #include "linalg/iterative_refinement.h"
@@ -249,13 +248,13 @@ Status LaplacianEditor::Impl::build_similarity_system(EditBuild& s, const Progre
   };
   Columns halves[2];
   int mid = nU;
-#if !defined(__EMSCRIPTEN__)
+#if MM_HAS_THREADS
   if (max_threads() > 1 && nU >= 2000) {
     mid = static_cast<int>(std::lower_bound(rev_ptr.begin(), rev_ptr.begin() + nU + 1, rev_ptr[nU] / 2) - rev_ptr.begin());
     mid = std::clamp(mid, 1, nU - 1);
-    std::thread second(sum_columns, mid, nU, &halves[1]);
+    Task second([&] { sum_columns(mid, nU, &halves[1]); });
     sum_columns(0, mid, &halves[0]);
-    second.join();
+    second.wait();
   }
 #endif
   if (mid == nU) sum_columns(0, nU, &halves[0]);

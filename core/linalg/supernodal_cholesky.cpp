@@ -5,7 +5,6 @@
 #include <cmath>
 #include <limits>
 #include <string>
-#include <thread>
 
 #include <Eigen/Cholesky>
 #include <Eigen/OrderingMethods>
@@ -290,14 +289,14 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
   // Supernodes the calling thread factors in order (all of them, or the top of the tree once the
   // subtrees below are done).
   std::vector<int> sequence;
-  // Two threads (natively, on large systems): the elimination tree is cut into disjoint subtrees
+  // Two threads (when the build has them, on large systems): the elimination tree is cut into disjoint subtrees
   // (the largest split into its children until none holds 45 % of the work; their postorder
   // ranges are contiguous) shared out by work between this thread and a second one; the
   // supernodes above them follow here. Measured on the 48k-unknown Eq. 7 system of michael3:
   // 26 % of the flops above the cut, 37 / 37 % below.
-  // (The wasm build has no threads: it always takes the sequential path.)
+  // (The single-threaded wasm build always takes the sequential path.)
   bool split = false;
-#if !defined(__EMSCRIPTEN__)
+#if MM_HAS_THREADS
   if (max_threads() > 1 && total_flops >= parallel_min_flops) {
     split = true;
     std::vector<int> snp(ns, -1), first(ns);
@@ -343,9 +342,9 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     };
     Scratch worker_scratch{std::vector<int>(n, -1), {}};
     Status main_status = Status::success();
-    std::thread worker(run, std::cref(bins[1]), std::ref(worker_scratch), &worker_status);
+    Task worker([&] { run(bins[1], worker_scratch, &worker_status); });
     run(bins[0], main_scratch, &main_status);
-    worker.join();
+    worker.wait();
     if (!main_status.ok()) return main_status;
     if (!worker_status.ok()) return worker_status;
     done_flops = load[0] + load[1];

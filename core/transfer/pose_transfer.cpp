@@ -2,7 +2,6 @@
 
 #include <atomic>
 #include <chrono>
-#include <future>
 #include <mutex>
 #include <algorithm>
 #include <cmath>
@@ -115,12 +114,13 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
   if (!(out.status = normalize(reference, "reference", &ref)).ok()) return out;
   if (!(out.status = normalize(source, "source", &src)).ok()) return out;
 
-  // 4–5. Cage and mean-value coordinates (Yin only). They depend on the source alone, so natively
-  // they run on a second thread while the eigenbases and the coupling are computed (the results
-  // are the same either way; with max_threads() = 1, and in WebAssembly, built without threads,
-  // they run in sequence below).
-  // Progress of the cage thread: recorded while this thread still computes its own stages, then
-  // forwarded (serialised by a mutex, fractions kept monotone) once this thread only waits for it.
+  // 4–5. Cage and mean-value coordinates (Yin only). They depend on the source alone, so with
+  // threads they run on a second thread while the eigenbases and the coupling are computed (the
+  // results are the same either way; with max_threads() = 1, and in the single-threaded wasm
+  // build, they run in sequence below).
+  // Progress of the cage thread: recorded under a mutex (fractions kept monotone) and reported by
+  // this thread alone — while it waits for the cage, it polls the record (in wasm the sink calls
+  // JavaScript, which only this thread can reach).
   struct CageStage {
     Status status;
     Eigen::MatrixXd C, Cn, Psi;
@@ -150,17 +150,16 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
     t = clock::now();
     r.Cn = (r.C.rowwise() - src.centroid) / src.scale;
     MeanValueCoordinates mvc;
-#if !defined(__EMSCRIPTEN__)
+#if MM_HAS_THREADS
     if (threaded && max_threads() > 1 && src.V.rows() >= 2048) {
       // Rows of Ψ are independent: the second half on another thread (by now the eigenbases
       // are usually done and their core is free).
       const Eigen::Index h = src.V.rows() / 2;
       const Eigen::MatrixXd lower_points = src.V.bottomRows(src.V.rows() - h);
-      auto lower = std::async(std::launch::async, [&] {
-        return mean_value_coordinates(lower_points, r.Cn, r.CF, mvc_progress);
-      });
+      MeanValueCoordinates rest;
+      Task lower([&] { rest = mean_value_coordinates(lower_points, r.Cn, r.CF, mvc_progress); });
       mvc = mean_value_coordinates(src.V.topRows(h), r.Cn, r.CF, mvc_progress);
-      MeanValueCoordinates rest = lower.get();
+      lower.wait();
       if (mvc.status.ok() && !rest.status.ok()) mvc.status = rest.status;
       if (mvc.status.ok()) {
         Eigen::MatrixXd Psi(src.V.rows(), r.Cn.rows());
@@ -186,14 +185,14 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
   std::atomic<bool> stop_cage{false};
   struct CageReport {
     std::mutex mutex;
-    bool forwarding = false;  // this thread waits: updates go straight to the caller's sink
     bool recorded = false;
     std::string stage;
     double fraction = 0;
   } report;
   const Progress cage_range = progress.sub(0.4, 0.85);
-  std::future<CageStage> cage_future;
-#if !defined(__EMSCRIPTEN__)
+  CageStage cage_result;
+  Task cage_task;  // declared after what it writes: an early return below waits for it first
+#if MM_HAS_THREADS
   if (opt.method == TransferMethod::Yin && max_threads() > 1) {
     const Progress watch([&](const std::string& stage, double f) {
       std::lock_guard<std::mutex> lock(report.mutex);
@@ -201,13 +200,12 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
       report.stage = stage;
       report.fraction = f;
       report.recorded = true;
-      if (report.forwarding && !cage_range.update(stage, f)) stop_cage.store(true);
       return !stop_cage.load();
     });
-    cage_future = std::async(std::launch::async, cage_stage, watch.sub(0.0, 0.45), watch.sub(0.45, 1.0), true);
+    cage_task = Task([&cage_result, cage_stage, watch] { cage_result = cage_stage(watch.sub(0.0, 0.45), watch.sub(0.45, 1.0), true); });
   }
 #endif
-  // Whatever returns early below stops the cage thread first (the future's destructor waits).
+  // Whatever returns early below stops the cage task first (the task's destructor then waits).
   struct StopOnExit {
     std::atomic<bool>& flag;
     ~StopOnExit() { flag.store(true); }
@@ -279,13 +277,25 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
   if (opt.method != TransferMethod::Yin) {
     Vn = src.V + PhiK_src * (alpha_ref - alpha_src);  // Eq. 4
   } else {
-    if (cage_future.valid()) {
-      std::lock_guard<std::mutex> lock(report.mutex);
-      report.forwarding = true;
-      if (report.recorded && !cage_range.update(report.stage, report.fraction)) stop_cage.store(true);
+    // Wait for the cage thread, reporting its progress from here every 40 ms.
+    const bool cage_threaded = cage_task.valid();
+    if (cage_threaded) {
+      bool done = false;
+      while (!done) {
+        done = cage_task.wait_for(std::chrono::milliseconds(40));
+        std::string stage;
+        double fraction = 0;
+        {
+          std::lock_guard<std::mutex> lock(report.mutex);
+          if (!report.recorded) continue;
+          stage = report.stage;
+          fraction = report.fraction;
+        }
+        if (!stop_cage.load() && !cage_range.update(stage, fraction)) stop_cage.store(true);
+      }
     }
-    CageStage cs = cage_future.valid() ? cage_future.get()
-                                       : cage_stage(progress.sub(0.4, 0.6), progress.sub(0.6, 0.85), false);
+    CageStage cs = cage_threaded ? std::move(cage_result)
+                                 : cage_stage(progress.sub(0.4, 0.6), progress.sub(0.6, 0.85), false);
     if (!cs.status.ok()) {
       out.status = cs.status;
       return out;

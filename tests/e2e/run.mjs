@@ -167,7 +167,36 @@ it('page loads, worker and wasm module start', async ({ page, pageErrors }) => {
   await page.waitForFunction(() => window.__meshmorph?.state.ready, null, { timeout: 60000 });
   const mode = await page.evaluate(() => window.__meshmorph.cancelMode);
   check(mode === 'cooperative', `page is not crossOriginIsolated (cancel mode ${mode}); COOP/COEP headers missing?`);
+  // Isolated: the threaded wasm build (web/src/worker/worker.js), with its pthread pool up.
+  const threads = await page.evaluate(() => window.__meshmorph.threads);
+  check(threads.threaded === true && threads.maxThreads >= 1, `the isolated page did not start the threaded module: ${JSON.stringify(threads)}`);
   check(pageErrors.length === 0, `uncaught page errors: ${pageErrors.join(' | ')}`);
+});
+
+// The same page from a server without COOP/COEP (no SharedArrayBuffer): the single-threaded
+// module, cancel by terminating the worker, and a computation still runs. Chromium only (the
+// Firefox runner drives one page).
+it('threads: without cross-origin isolation the page falls back to the single-threaded module', async ({ context }) => {
+  const server = await plainServer(path.join(repoDir, 'build/web-dist'));
+  const page = await context.newPage();
+  try {
+    await page.goto(`http://127.0.0.1:${server.address().port}/`);
+    await page.waitForFunction(() => window.__meshmorph?.state.loads >= 1 || window.__meshmorph?.state.error, null, { timeout: 60000 });
+    const state = await page.evaluate(() => ({
+      isolated: window.crossOriginIsolated, threads: window.__meshmorph.threads, cancel: window.__meshmorph.cancelMode,
+      status: document.getElementById('status').textContent, error: window.__meshmorph.state.error,
+    }));
+    check(!state.isolated && !state.threads.threaded && state.threads.maxThreads === 1 && state.cancel === 'terminate' && !state.error,
+      `not the single-threaded fallback: ${JSON.stringify(state)}`);
+    await computeBasis(page, 10);
+    await page.waitForFunction(() => window.__meshmorph.state.eigen?.k === 10 || window.__meshmorph.state.error, null, { timeout: 60000 });
+    check(await page.evaluate(() => window.__meshmorph.state.eigen?.k === 10), `no eigenbasis: ${JSON.stringify(await page.evaluate(() => window.__meshmorph.state.error))}`);
+    check(/one thread/.test(await page.textContent('#status')) || /one thread/.test(state.status), `status does not say one thread: ${state.status}`);
+    await shot(page, '00-no-isolation-one-thread');
+  } finally {
+    await page.close();
+    await new Promise((resolve) => server.close(resolve));
+  }
 });
 
 it('the default sample mesh renders (canvas not blank)', async ({ page }) => {
@@ -1425,6 +1454,24 @@ function pageIsStale() {
   };
   walk(path.join(repoDir, 'web'));
   return inputs.some((f) => fs.existsSync(f) && fs.statSync(f).mtimeMs > builtAt);
+}
+
+// A static server for build/web-dist without the isolation headers (the fallback test).
+async function plainServer(root) {
+  const http = await import('node:http');
+  const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript', '.css': 'text/css', '.wasm': 'application/wasm', '.json': 'application/json' };
+  const server = http.createServer((req, res) => {
+    const rel = decodeURIComponent(new URL(req.url, 'http://x').pathname).replace(/^\/+/, '') || 'index.html';
+    const file = path.join(root, rel);
+    if (!file.startsWith(root) || !fs.existsSync(file) || fs.statSync(file).isDirectory()) {
+      res.writeHead(404).end();
+      return;
+    }
+    res.writeHead(200, { 'Content-Type': types[path.extname(file)] || 'application/octet-stream' });
+    fs.createReadStream(file).pipe(res);
+  });
+  await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
+  return server;
 }
 
 async function main() {

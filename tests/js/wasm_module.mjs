@@ -9,25 +9,43 @@ import { fileURLToPath } from 'node:url';
 
 export const repoDir = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 export const wasmDir = path.resolve(repoDir, process.env.MM_WASM_DIR || 'build/wasm/wasm');
+// The threaded build (-pthread, scripts/build wasm): MM_WASM_THREADED=1 runs the tests on it.
+export const wasmThreadedDir = path.resolve(repoDir, process.env.MM_WASM_MT_DIR || 'build/wasm-mt/wasm');
+const threadedByDefault = process.env.MM_WASM_THREADED === '1';
 
-let modulePromise = null;
+const modules = new Map(); // variant → Promise<module>
 
-export function loadModule() {
-  if (!modulePromise) {
-    const file = path.join(wasmDir, 'meshmorph_node.cjs');
-    if (!fs.existsSync(file)) throw new Error(`${file} is missing: build the wasm target meshmorph_node (or set MM_WASM_DIR)`);
+// The node build of the module: 'single' (meshmorph_node.cjs) or 'threaded' (meshmorph_node_mt.cjs);
+// the default is the single-threaded one unless MM_WASM_THREADED=1.
+export function loadModule(variant = threadedByDefault ? 'threaded' : 'single') {
+  if (!modules.has(variant)) {
+    const threaded = variant === 'threaded';
+    const file = threaded ? path.join(wasmThreadedDir, 'meshmorph_node_mt.cjs') : path.join(wasmDir, 'meshmorph_node.cjs');
+    if (!fs.existsSync(file)) {
+      throw new Error(`${file} is missing: build the wasm target meshmorph_node (scripts/build wasm; or set ${threaded ? 'MM_WASM_MT_DIR' : 'MM_WASM_DIR'})`);
+    }
     const require = createRequire(import.meta.url);
     const createMeshMorph = require(file);
-    // Built with WASM_ASYNC_COMPILATION=0: the factory returns the module, not a Promise;
-    // `await` handles both.
-    modulePromise = Promise.resolve(createMeshMorph());
+    // The single-threaded build compiles synchronously: the factory returns the module. The
+    // threaded one compiles asynchronously (its pthread glue needs the factory's Promise) and is
+    // handed its .wasm bytes (node 20's fetch() cannot read a path); its runtime is up once
+    // `ready` resolves, after the pthread pool has loaded.
+    const made = threaded ? createMeshMorph({ wasmBinary: fs.readFileSync(file.replace(/\.cjs$/, '.wasm')) }) : createMeshMorph();
+    // Node keeps running while a worker thread is referenced: the pool's idle workers are
+    // unref'd so a test file ends when its tests do (a running pthread is always joined by the
+    // calling thread, which keeps the process alive meanwhile).
+    const unrefPool = (module) => {
+      for (const w of module.PThread?.unusedWorkers || []) w.unref?.();
+      return module;
+    };
+    modules.set(variant, Promise.resolve(made.ready || made).then(unrefPool));
   }
-  return modulePromise;
+  return modules.get(variant);
 }
 
 // A fresh worker-like context: module + per-worker state + a progress sink.
-export async function makeContext(progress = () => true) {
-  return { module: await loadModule(), state: { meshes: new Map() }, progress };
+export async function makeContext(progress = () => true, variant = undefined) {
+  return { module: await loadModule(variant), state: { meshes: new Map() }, progress };
 }
 
 export function dataBytes(relative) {

@@ -4,7 +4,8 @@
 // worker/ops/index.js.
 //
 // URL parameters: ?sample=<id> (initial gallery mesh), ?cancel=terminate (use the
-// terminate-and-respawn cancel even when SharedArrayBuffer is available; see lib/client.js).
+// terminate-and-respawn cancel even when SharedArrayBuffer is available; see lib/client.js),
+// ?threads=1 (the single-threaded wasm build even when the page is cross-origin isolated).
 import { MeshMorphClient } from './lib/client.js';
 import { byId } from './ui/dom.js';
 import { panels } from './ui/panels/index.js';
@@ -16,6 +17,8 @@ const params = new URLSearchParams(location.search);
 const viewer = new Viewer(byId('view'));
 const client = new MeshMorphClient({
   createWorker: () => new Worker(new URL('./worker/worker.js', import.meta.url), { type: 'module' }),
+  // Served beside the page, not bundled (vite.config.js, meshmorphThreadedModule).
+  threadedModuleUrl: params.get('threads') === '1' ? null : new URL('wasm-mt/meshmorph_web_mt.mjs', document.baseURI).href,
   cancelMode: params.get('cancel') === 'terminate' ? 'terminate' : 'auto',
   onStatus: (text) => shell.notice(text), // eslint-disable-line no-use-before-define
   onRestart: (detail) => shell.workerRestarted(detail), // eslint-disable-line no-use-before-define
@@ -39,6 +42,7 @@ window.__meshmorph = {
   }),
   get cancelMode() { return client.cancelMode; },
   get restarts() { return client.restarts; },
+  get threads() { return client.threads; },
 };
 
 shell.start();

@@ -23,8 +23,12 @@ export class MeshMorphClient {
   // createWorker: () => Worker-like {postMessage, terminate, onmessage, onerror}.
   // cancelMode: 'auto' (cooperative when crossOriginIsolated), 'cooperative' or 'terminate'.
   // onStatus: (text) => void, for diagnostics (worker restarts).
-  constructor({ createWorker, maxInitAttempts = 3, cancelGraceMs = 2000, cancelMode = 'auto', onStatus = () => {}, onRestart = () => {} }) {
+  constructor({ createWorker, threadedModuleUrl = null, maxInitAttempts = 3, cancelGraceMs = 2000, cancelMode = 'auto', onStatus = () => {}, onRestart = () => {} }) {
     this.createWorker = createWorker;
+    // The threaded wasm build needs shared memory: offered to the worker only when this page is
+    // crossOriginIsolated (worker/worker.js falls back to the single-threaded build otherwise).
+    this.threadedModuleUrl = globalThis.crossOriginIsolated === true ? threadedModuleUrl : null;
+    this.threads = { threaded: false, maxThreads: 1 }; // from the worker's 'ready'
     this.onRestart = onRestart;
     this.maxInitAttempts = maxInitAttempts;
     this.cancelGraceMs = cancelGraceMs;
@@ -41,6 +45,13 @@ export class MeshMorphClient {
   }
 
   get cancelMode() { return this.cooperative ? 'cooperative' : 'terminate'; }
+
+  // For the status line: how the worker computes and cancels, e.g. "2 threads · cancel: cooperative".
+  get runtimeSummary() {
+    const { threaded, maxThreads } = this.threads;
+    const threads = threaded && maxThreads > 1 ? `${maxThreads} threads` : 'one thread';
+    return `${threads} · cancel: ${this.cancelMode}`;
+  }
 
   // Starts a worker and waits for 'ready', retrying with a fresh worker on failure; then
   // replays the restore requests. Resolves to the ready message.
@@ -68,6 +79,8 @@ export class MeshMorphClient {
       worker.onmessage = (event) => {
         const message = event.data;
         if (message.type === 'ready') {
+          if (message.threads) this.threads = message.threads;
+          if (message.note) this.onStatus(message.note);
           worker.onmessage = (e) => this.handle(worker, e.data);
           worker.onerror = (e) => this.crashed(worker, e.message || 'worker error');
           resolve(message);
@@ -79,7 +92,7 @@ export class MeshMorphClient {
         e.preventDefault?.();
         reject(new MeshMorphError('InitFailed', e.message || 'worker script failed to load'));
       };
-      worker.postMessage({ type: 'init', cancelFlag: this.cancelFlag });
+      worker.postMessage({ type: 'init', cancelFlag: this.cancelFlag, threadedModuleUrl: this.threadedModuleUrl });
     });
   }
 

@@ -220,7 +220,7 @@ export class Shell {
       () => {
         this.state.ready = true;
         this.setBusy(null);
-        this.setStatus(`ready · cancel: ${this.client.cancelMode}`);
+        this.setStatus(`ready · ${this.client.runtimeSummary}`);
         this.emit('ready');
       },
       (e) => {

@@ -19,7 +19,7 @@ import { errorMessage, transferList } from '../lib/protocol.js';
 // second); a progress bar needs ~20 updates per second and postMessage is not free.
 const progressIntervalMs = 50;
 
-// loadModule: () => Promise<Emscripten module>; opFiles: {file: {ops}} (the ops list,
+// loadModule: (init message) => Promise<Emscripten module | {module, note}>; opFiles: {file: {ops}} (the ops list,
 // worker/ops/index.js); post: (message, transferList) => void.
 export function createWorkerRuntime({ loadModule, opFiles, post }) {
   let ctx = null;
@@ -33,9 +33,15 @@ export function createWorkerRuntime({ loadModule, opFiles, post }) {
     try {
       ops = collectOps(opFiles);
       cancelFlag = message.cancelFlag instanceof Int32Array ? message.cancelFlag : null;
-      const module = await loadModule();
+      const loaded = await loadModule(message);
+      // loadModule gives the module, or {module, note} (worker.js: which build, and why).
+      const module = loaded?.module ?? loaded;
       ctx = { module, state: { meshes: new Map() }, progress: () => true };
-      send({ type: 'ready', ops: [...ops.keys()], cooperativeCancel: Boolean(cancelFlag) });
+      const threads = typeof module.threads === 'function' ? module.threads() : { threaded: false, maxThreads: 1 };
+      send({
+        type: 'ready', ops: [...ops.keys()], cooperativeCancel: Boolean(cancelFlag),
+        threads: { threaded: threads.threaded, maxThreads: threads.maxThreads }, note: loaded?.note || '',
+      });
     } catch (e) {
       send(errorMessage(null, new MeshMorphError('InitFailed', `could not start the geometry module: ${e?.message || e}`, { fatal: true })));
     }

@@ -477,7 +477,7 @@ export const panel = {
       showColors(side);
       if (merge.mode === 'dependent' && side === 'source') placeSource();
       arrange({ frame: true });
-      app.setStatus(`${side}: ${info.name}${cuts.length ? `, cut ${cuts.length}×` : ''} — ${info.weldedVertices} vertices, ${info.faces} faces, ${info.loops.length} boundary loop(s) · cancel: ${client.cancelMode}`);
+      app.setStatus(`${side}: ${info.name}${cuts.length ? `, cut ${cuts.length}×` : ''} — ${info.weldedVertices} vertices, ${info.faces} faces, ${info.loops.length} boundary loop(s) · ${client.runtimeSummary}`);
       refresh();
       return true;
     }

@@ -142,7 +142,7 @@ export const panel = {
       showPicks();
       showMaterials(copies, info);
       $('credit').textContent = credit;
-      app.setStatus(`${info.name}: ${info.weldedVertices} vertices, ${info.report.faces} faces · cancel: ${client.cancelMode}`);
+      app.setStatus(`${info.name}: ${info.weldedVertices} vertices, ${info.report.faces} faces · ${client.runtimeSummary}`);
       app.emit('mesh', state.mesh);
       return true;
     }

@@ -299,7 +299,7 @@ export const panel = {
         restRaw: b.positions.slice(), triangles: weldedTriangles(b.indices, b.toWelded),
       };
       transfer[side] = { name: info.name, rawVertices: info.rawVertices, weldedVertices: info.weldedVertices };
-      app.setStatus(`${side}: ${info.name}, ${info.weldedVertices} vertices, ${info.report.faces} faces · cancel: ${client.cancelMode}`);
+      app.setStatus(`${side}: ${info.name}, ${info.weldedVertices} vertices, ${info.report.faces} faces · ${client.runtimeSummary}`);
       pair.setMesh(side, b, { open: info.report.boundaryLoopLengths.length > 0 || info.report.components === 0 });
       if (copies) {
         const entry = meshes[side];
