@@ -149,7 +149,26 @@ bool Task::wait_for(std::chrono::milliseconds timeout) {
     pool.run(state_);
     lock.lock();
   }
-  if (!pool.task_done.wait_for(lock, timeout, [this] { return state_->phase == State::Done; })) return false;
+  // While a pool thread runs it, this thread helps with other queued tasks (it would only wait
+  // otherwise; e.g. the transfer's caller runs the cage thread's second half of the mean-value
+  // rows), then waits.
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (state_->phase != State::Done) {
+    std::shared_ptr<State> other;
+    while (!pool.queue.empty() && !other) {
+      other = std::move(pool.queue.front());
+      pool.queue.pop_front();
+      if (other->phase != State::Queued) other.reset();
+    }
+    if (other) {
+      other->phase = State::Running;
+      lock.unlock();
+      pool.run(other);
+      lock.lock();
+      continue;
+    }
+    if (pool.task_done.wait_until(lock, deadline) == std::cv_status::timeout && state_->phase != State::Done) return false;
+  }
   std::exception_ptr error = state_->error;
   state_.reset();
   if (error) std::rethrow_exception(error);

@@ -43,8 +43,9 @@ constexpr int kMaxPoolThreads = 3;
 
 // A piece of work handed to the pool. It runs on a pool thread if one takes it before the owner
 // waits; otherwise the owner runs it itself in wait() (so a busy or empty pool, or a task started
-// from a pool thread, never deadlocks). With max_threads() = 1 it is always run in wait().
-// Exceptions from the work are rethrown by wait(). The destructor waits (without rethrowing).
+// from a pool thread, never deadlocks). While a pool thread runs it, the waiting owner runs other
+// queued tasks. With max_threads() = 1 it is always run in wait(). Exceptions from the work are
+// rethrown by wait(). The destructor waits (without rethrowing).
 class Task {
  public:
   Task() = default;
