@@ -152,8 +152,8 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
     MeanValueCoordinates mvc;
 #if MM_HAS_THREADS
     if (threaded && max_threads() > 1 && src.V.rows() >= 2048) {
-      // Rows of Ψ are independent: the second half on another thread (by now the eigenbases
-      // are usually done and their core is free).
+      // Rows of Ψ are independent: the second half is a task of its own (the calling thread
+      // takes it once it only waits for the cage; common/threads.h).
       const Eigen::Index h = src.V.rows() / 2;
       const Eigen::MatrixXd lower_points = src.V.bottomRows(src.V.rows() - h);
       MeanValueCoordinates rest;
@@ -277,7 +277,8 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
   if (opt.method != TransferMethod::Yin) {
     Vn = src.V + PhiK_src * (alpha_ref - alpha_src);  // Eq. 4
   } else {
-    // Wait for the cage thread, reporting its progress from here every 40 ms.
+    // Wait for the cage task, reporting its progress from here every 40 ms (and running the
+    // mean-value rows' second half when it is queued).
     const bool cage_threaded = cage_task.valid();
     if (cage_threaded) {
       bool done = false;
