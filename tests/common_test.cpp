@@ -148,4 +148,23 @@ TEST(Tasks, TwoHalvesGiveTheSameSumAsOneLoop) {
   EXPECT_EQ(lo + hi, one);
 }
 
+TEST(Tasks, ParallelBlocksCoverTheRangeOnceInContiguousBlocks) {
+  for (int threads : {1, 2, 4}) {
+    ThreadCount count(threads);
+    for (long n : {0L, 1L, 7L, 1000L, 1001L}) {
+      std::vector<std::atomic<int>> hits(static_cast<size_t>(n));
+      for (auto& h : hits) h = 0;
+      std::atomic<int> calls{0};
+      parallel_blocks(n, 100, [&](long begin, long end) {
+        ++calls;
+        EXPECT_LT(begin, end);
+        for (long i = begin; i < end; ++i) ++hits[static_cast<size_t>(i)];
+      });
+      for (long i = 0; i < n; ++i) EXPECT_EQ(hits[static_cast<size_t>(i)].load(), 1) << "n " << n << " item " << i;
+      // At most one block per thread, and none smaller than asked unless the range is.
+      EXPECT_LE(calls.load(), std::max(1, std::min<int>(threads, static_cast<int>(std::max(1L, n / 100)))));
+    }
+  }
+}
+
 }  // namespace mm

@@ -25,6 +25,7 @@
 #include "character/joint_set.h"
 #include "retarget/lbs_baseline.h"
 #include "retarget/mfs_kernel.h"
+#include "common/threads.h"
 #include "test_support.h"
 
 namespace {
@@ -108,6 +109,23 @@ TEST(RetargetKernel, DerivativesMatchFiniteDifferences) {
     }
   const Eigen::MatrixXd trace = H.middleRows(0, 1) + H.middleRows(1, 1) + H.middleRows(2, 1);
   EXPECT_LT(trace.norm(), 1e-12);
+}
+
+// The per-frame vertex product (Ktᵀ times three columns) splits its columns across the task
+// threads (common/threads.h parallel_blocks): the same bits on 1, 2 and 4 threads, and the plain
+// product to rounding.
+TEST(RetargetKernel, TransposedProductIsTheSameOnAnyThreadCount) {
+  const Eigen::MatrixXd Mt = Eigen::MatrixXd::Random(263, 7001), B = Eigen::MatrixXd::Random(263, 3);
+  Eigen::MatrixXd out[3];
+  const int counts[3] = {1, 2, 4};
+  for (int t = 0; t < 3; ++t) {
+    mm::set_max_threads(counts[t]);
+    out[t] = mm::transposed_times_n3(Mt, B);
+  }
+  mm::set_max_threads(0);
+  EXPECT_TRUE(out[0] == out[1]);
+  EXPECT_TRUE(out[0] == out[2]);
+  EXPECT_LT((out[0] - Mt.transpose() * B).cwiseAbs().maxCoeff(), 1e-12);
 }
 
 TEST(RetargetHarmonicMap, FitsRigidAndBentTube) {

@@ -102,10 +102,12 @@ struct Pool {
     }
   }
 
-  // Called with the mutex held: at most min(max_threads() − 1, kMaxPoolThreads) threads.
+  // Called with the mutex held, by the first task's owner: all kMaxPoolThreads threads at once
+  // (idle ones only wait; `busy` keeps the running ones within max_threads() − 1). Starting them
+  // together from the first owner matters in wasm: a pthread started from another pthread is
+  // spawned by the main thread's event loop, which never turns while an op blocks on its tasks.
   void grow_locked() {
-    const int wanted = std::min(max_threads() - 1, kMaxPoolThreads);
-    while (threads < wanted) {
+    while (threads < kMaxPoolThreads) {
       std::thread(&Pool::loop, this).detach();
       ++threads;
     }
@@ -185,6 +187,21 @@ void Task::finish_quietly() noexcept {
     wait();
   } catch (...) {
   }
+}
+
+void parallel_blocks(long n, long min_block, const std::function<void(long, long)>& fn) {
+  if (n <= 0) return;
+  const long most = std::max(1L, n / std::max(1L, min_block));
+  const long blocks = std::min<long>({static_cast<long>(std::max(1, max_threads())), static_cast<long>(kMaxPoolThreads) + 1, most});
+  if (blocks <= 1) {
+    fn(0, n);
+    return;
+  }
+  std::vector<Task> tasks;
+  tasks.reserve(static_cast<size_t>(blocks - 1));
+  for (long b = 1; b < blocks; ++b) tasks.emplace_back([&fn, b, blocks, n] { fn(n * b / blocks, n * (b + 1) / blocks); });
+  fn(0, n / blocks);  // (an exception here waits for the tasks in their destructors)
+  for (Task& t : tasks) t.wait();
 }
 
 }  // namespace mm

@@ -67,4 +67,11 @@ class Task {
   std::shared_ptr<State> state_;
 };
 
+// Splits [0, n) into up to min(max_threads(), kMaxPoolThreads + 1) contiguous blocks of at least
+// `min_block` items and runs fn(begin, end) on each: the first block on the calling thread, the
+// others as tasks; returns when all are done (rethrowing the first block's exception, else a
+// task's). fn must write disjoint outputs and compute each item the same way whatever its block,
+// so the results do not depend on the thread count. fn must not report progress.
+void parallel_blocks(long n, long min_block, const std::function<void(long begin, long end)>& fn);
+
 }  // namespace mm

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <vector>
 
+#include "common/threads.h"
+
 namespace mm {
 
 namespace retarget_detail {
@@ -60,7 +62,11 @@ Eigen::MatrixXd transposed_times_n3(const Eigen::MatrixXd& Mt, const Eigen::Matr
   for (Eigen::Index i = 0; i < k; ++i)
     for (int c = 0; c < 3; ++c) b[3 * i + c] = B(i, c);
   Eigen::MatrixXd out(n, 3);
-  for (Eigen::Index j = 0; j < n; ++j) {
+  // Columns are independent: split in blocks of at least ~1e5 multiply-adds across the task
+  // threads (the per-frame vertex product of the retargeter; bit-identical for any split).
+  const long min_cols = std::max<long>(1, 100000 / std::max<long>(1, 3 * static_cast<long>(k)));
+  parallel_blocks(static_cast<long>(n), min_cols, [&](long begin, long end) {
+  for (Eigen::Index j = begin; j < end; ++j) {
     const double* m = Mt.col(j).data();
     double x0 = 0, y0 = 0, z0 = 0, x1 = 0, y1 = 0, z1 = 0;  // two chains for instruction-level parallelism
     Eigen::Index i = 0;
@@ -82,6 +88,7 @@ Eigen::MatrixXd transposed_times_n3(const Eigen::MatrixXd& Mt, const Eigen::Matr
     out(j, 1) = y0 + y1;
     out(j, 2) = z0 + z1;
   }
+  });
   return out;
 }
 

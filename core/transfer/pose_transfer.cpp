@@ -152,20 +152,26 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
     MeanValueCoordinates mvc;
 #if MM_HAS_THREADS
     if (threaded && max_threads() > 1 && src.V.rows() >= 2048) {
-      // Rows of Ψ are independent: the second half is a task of its own (the calling thread
-      // takes it once it only waits for the cage; common/threads.h).
-      const Eigen::Index h = src.V.rows() / 2;
-      const Eigen::MatrixXd lower_points = src.V.bottomRows(src.V.rows() - h);
-      MeanValueCoordinates rest;
-      Task lower([&] { rest = mean_value_coordinates(lower_points, r.Cn, r.CF, mvc_progress); });
-      mvc = mean_value_coordinates(src.V.topRows(h), r.Cn, r.CF, mvc_progress);
-      lower.wait();
-      if (mvc.status.ok() && !rest.status.ok()) mvc.status = rest.status;
+      // Rows of Ψ are independent: computed in blocks of rows, all but the first as tasks (the
+      // calling thread takes one once it only waits for the cage; common/threads.h).
+      const Eigen::Index n = src.V.rows();
+      const int blocks = std::min<int>(max_threads(), kMaxPoolThreads + 1);
+      std::vector<MeanValueCoordinates> part(static_cast<size_t>(blocks));
+      auto rows_of = [&](int b) { return std::make_pair(n * b / blocks, n * (b + 1) / blocks); };
+      std::vector<Task> rest;
+      for (int b = 1; b < blocks; ++b)
+        rest.emplace_back([&, b] {
+          const auto [begin, end] = rows_of(b);
+          part[b] = mean_value_coordinates(src.V.middleRows(begin, end - begin), r.Cn, r.CF, mvc_progress);
+        });
+      part[0] = mean_value_coordinates(src.V.topRows(rows_of(0).second), r.Cn, r.CF, mvc_progress);
+      for (Task& t : rest) t.wait();
+      mvc.status = Status::success();
+      for (const MeanValueCoordinates& p : part)
+        if (mvc.status.ok() && !p.status.ok()) mvc.status = p.status;
       if (mvc.status.ok()) {
-        Eigen::MatrixXd Psi(src.V.rows(), r.Cn.rows());
-        Psi.topRows(h) = mvc.Psi;
-        Psi.bottomRows(src.V.rows() - h) = rest.Psi;
-        mvc.Psi = std::move(Psi);
+        mvc.Psi.resize(n, r.Cn.rows());
+        for (int b = 0; b < blocks; ++b) mvc.Psi.middleRows(rows_of(b).first, part[b].Psi.rows()) = part[b].Psi;
       }
     } else
 #endif

@@ -2,15 +2,16 @@
 // against the single-threaded one, through the worker's ops: the stages that run on two threads
 // (the transfer's cage and mean-value coordinates beside the eigenbases, the mean-value rows in two
 // halves; the editor's Poisson factor beside the Eq. 7 system, whose columns and supernodal
-// factor are split in two) give the same bits as one thread and as the single-threaded build;
+// factor are split in two; the retargeter's per-frame vertex product in column blocks) give the same bits as one thread and as the single-threaded build;
 // progress still comes from the calling thread only, and cancel stops a threaded run.
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import { MeshMorphError } from '../../web/src/lib/errors.js';
 import { ops as editOps } from '../../web/src/worker/ops/edit.js';
 import { ops as meshOps } from '../../web/src/worker/ops/mesh.js';
+import { ops as retargetOps } from '../../web/src/worker/ops/retarget.js';
 import { ops as transferOps } from '../../web/src/worker/ops/transfer.js';
-import { fileBuffers, loadModule, makeContext } from './wasm_module.mjs';
+import { dataBytes, fileBuffers, loadModule, makeContext } from './wasm_module.mjs';
 
 const same = (a, b) => a.length === b.length && Buffer.from(a.buffer, a.byteOffset, a.byteLength).equals(Buffer.from(b.buffer, b.byteOffset, b.byteLength));
 
@@ -96,3 +97,25 @@ test('edit (14.6k vertices): precompute, drag and finalize agree to the bit acro
   for (let i = 0; i < W.length; i++) moved = Math.max(moved, Math.abs(W[i] - two.drag[i]));
   assert.ok(moved > 0.01, `the drag did not move the mesh (${moved})`);
 });
+
+// Fox (Walk) → wolf0 with its placed joints: precompute and 4 frames.
+function retargetFox(ctx) {
+  const { info } = retargetOps.retargetPrepare(
+    ctx,
+    { sourceName: 'Fox.glb', targetName: 'wolf0.ply', targetJointsJson: new TextDecoder().decode(dataBytes('joints/wolf0_joints.json')),
+      clip: 'Walk', fps: 15, first_frame: 0, last_frame: 4 },
+    { source: dataBytes('anim/Fox/glTF-Binary/Fox.glb'), target: dataBytes('anim/wolf0.ply') });
+  const frames = retargetOps.retargetFrames(ctx, { session: info.session, first: 0 }).buffers.positions;
+  retargetOps.retargetDispose(ctx, { session: info.session });
+  return frames;
+}
+
+test('retarget (Fox → wolf0): frames agree to the bit across builds and thread counts', async () => {
+  const single = await withThreads('single', 1, (ctx) => retargetFox(ctx));
+  const two = await withThreads('threaded', 2, (ctx) => retargetFox(ctx));
+  const four = await withThreads('threaded', 4, (ctx) => retargetFox(ctx));
+  assert.ok(single.length > 3 * 1000 && single.every(Number.isFinite));
+  assert.ok(same(single, two), 'two threads differ from the single-threaded build');
+  assert.ok(same(single, four), 'four threads differ from the single-threaded build');
+});
+
