@@ -5,6 +5,7 @@
 
 #include <Eigen/SVD>
 
+#include "common/threads.h"
 #include "mesh/mesh.h"
 #include "retarget/mfs_kernel.h"
 #include "spatial/triangle_bvh.h"
@@ -23,26 +24,36 @@ SingularityResult singularity_points(const Eigen::MatrixXd& V, const Eigen::Matr
   const SurfaceSamples S = surface_samples(V, F, opt.candidates);
   // Spread the candidate seeds first so that the work does not depend on the mesh density.
   const std::vector<int> seeds = farthest_point_sampling(S.P, opt.candidates, 0);
-  std::vector<Eigen::Vector3d> cand;
-  std::vector<double> clearance;
-  cand.reserve(2 * seeds.size());
-  for (int s : seeds) {
-    const Eigen::Vector3d p = S.P.row(s).transpose(), n = S.N.row(s).transpose();
-    if (!(n.squaredNorm() > 0)) continue;
-    for (double side : {1.0, -1.0}) {
-      // The largest offset that fits on this side: thin gaps get smaller offsets instead of none.
-      double o = opt.offset * diag;
-      for (int level = 0; level <= opt.offset_levels; ++level, o *= 0.5) {
-        const Eigen::Vector3d c = p + side * o * n;
-        const ClosestPoint cp = bvh.closest_point(c);
-        if (cp.sq_distance < 0.64 * o * o) continue;
-        if (bvh.inside(c)) break;  // a smaller offset on the same side is inside as well
-        cand.push_back(c);
-        clearance.push_back(std::sqrt(cp.sq_distance));
-        break;
+  // Each seed's two offset candidates are independent: computed in blocks of seeds across the
+  // task threads (common/threads.h) into per-seed slots, then kept in seed order.
+  const long ns = static_cast<long>(seeds.size());
+  std::vector<Eigen::Vector3d> slot(2 * seeds.size());
+  std::vector<double> slot_clearance(2 * seeds.size(), -1.0);  // < 0: no candidate on that side
+  parallel_blocks(ns, 64, [&](long begin, long end) {
+    for (long k = begin; k < end; ++k) {
+      const int s = seeds[static_cast<size_t>(k)];
+      const Eigen::Vector3d p = S.P.row(s).transpose(), n = S.N.row(s).transpose();
+      if (!(n.squaredNorm() > 0)) continue;
+      for (int side = 0; side < 2; ++side) {
+        // The largest offset that fits on this side: thin gaps get smaller offsets instead of none.
+        double o = opt.offset * diag;
+        for (int level = 0; level <= opt.offset_levels; ++level, o *= 0.5) {
+          const Eigen::Vector3d c = p + (side == 0 ? 1.0 : -1.0) * o * n;
+          const ClosestPoint cp = bvh.closest_point(c);
+          if (cp.sq_distance < 0.64 * o * o) continue;
+          if (bvh.inside(c)) break;  // a smaller offset on the same side is inside as well
+          slot[static_cast<size_t>(2 * k + side)] = c;
+          slot_clearance[static_cast<size_t>(2 * k + side)] = std::sqrt(cp.sq_distance);
+          break;
+        }
       }
     }
-  }
+  });
+  std::vector<Eigen::Vector3d> cand;
+  std::vector<double> clearance;
+  cand.reserve(slot.size());
+  for (size_t i = 0; i < slot.size(); ++i)
+    if (slot_clearance[i] >= 0) cand.push_back(slot[i]), clearance.push_back(slot_clearance[i]);
   if (cand.empty()) {
     r.status = Status::error(StatusCode::InvalidMesh,
                              "cannot place singularity points: no offset point lies outside the surface");
@@ -91,12 +102,16 @@ Status MfsHarmonicMap::build(const Eigen::MatrixXd& V_in, const Eigen::MatrixXi&
     // sides) are left out of the fit.
     const TriangleBvh bvh(V, F);
     const double eps = 2e-3 * bounding_box_diagonal(V);
+    std::vector<char> buried(static_cast<size_t>(all.size()), 0);
+    parallel_blocks(all.size(), 256, [&](long begin, long end) {
+      for (long s = begin; s < end; ++s) {
+        const Eigen::Vector3d p = all.P.row(s).transpose(), n = all.N.row(s).transpose();
+        buried[static_cast<size_t>(s)] = bvh.inside(p + eps * n) && bvh.inside(p - eps * n);
+      }
+    });
     std::vector<int> keep;
-    for (int s = 0; s < all.size(); ++s) {
-      const Eigen::Vector3d p = all.P.row(s).transpose(), n = all.N.row(s).transpose();
-      if (bvh.inside(p + eps * n) && bvh.inside(p - eps * n)) continue;
-      keep.push_back(s);
-    }
+    for (int s = 0; s < all.size(); ++s)
+      if (!buried[static_cast<size_t>(s)]) keep.push_back(s);
     if (keep.size() >= 4 * static_cast<size_t>(Q_.rows())) all = select_samples(all, keep);
   }
   colloc_ = select_samples(all, farthest_point_sampling(all.P, opt.num_collocation, 0));
