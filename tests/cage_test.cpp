@@ -7,6 +7,7 @@
 #include "cage/cage_containment.h"
 #include "cage/enclosing_cage.h"
 #include "cage/mean_value_coordinates.h"
+#include "common/threads.h"
 #include "io/asset.h"
 #include "mesh/mesh.h"
 #include "mesh/validate.h"
@@ -69,6 +70,34 @@ TEST(CageMvc, CubeInteriorPointsReproduced) {
   centre << 0.5, 0.5, 0.5;
   MeanValueCoordinates mc = mean_value_coordinates(centre, C, CF);
   cage_test::expect_reproduces(mc.Psi, C, centre, 1e-14);
+}
+
+// The rows are computed in blocks across the task threads: the same bits on 1, 2 and 4 threads,
+// and a failing point is named by its index in the whole set (here the last one, far outside).
+TEST(CageMvc, BlocksAcrossThreadsGiveTheSameRowsAndNameTheFailingPoint) {
+  Eigen::MatrixXd C;
+  Eigen::MatrixXi CF;
+  cage_test::cube(&C, &CF);
+  cage_test::Lcg rng;
+  Eigen::MatrixXd P(5000, 3);
+  for (int i = 0; i < P.rows(); ++i)
+    for (int c = 0; c < 3; ++c) P(i, c) = 0.01 + 0.98 * rng.next();
+  Eigen::MatrixXd Psi[3];
+  const int counts[3] = {1, 2, 4};
+  for (int t = 0; t < 3; ++t) {
+    set_max_threads(counts[t]);
+    MeanValueCoordinates m = mean_value_coordinates(P, C, CF);
+    ASSERT_TRUE(m.status.ok()) << m.status.message;
+    Psi[t] = m.Psi;
+  }
+  EXPECT_TRUE(Psi[0] == Psi[1]);
+  EXPECT_TRUE(Psi[0] == Psi[2]);
+  P.row(4999) << 1e30, 1e30, 1e30;
+  set_max_threads(2);
+  const MeanValueCoordinates bad = mean_value_coordinates(P, C, CF);
+  set_max_threads(0);
+  EXPECT_FALSE(bad.status.ok());
+  EXPECT_NE(bad.status.message.find("point 4999"), std::string::npos) << bad.status.message;
 }
 
 TEST(CageMvc, PointsNearAndOnFacesAndVertices) {

@@ -1,8 +1,9 @@
 // How many threads the core may keep busy at once, and the tasks it hands to other threads.
 //
 // The core overlaps independent stages (the transfer's cage and mean-value coordinates beside the
-// eigenbases, the editor's Poisson factor beside the Eq. 7 system) and splits a few loops in two
-// fixed halves (the Eq. 7 columns, the supernodal factor's subtrees, the mean-value rows). Each
+// eigenbases, the editor's Poisson factor beside the Eq. 7 system) and splits a few loops (the
+// Eq. 7 columns and the supernodal factor's subtrees in two; mean-value rows, the retargeter's
+// per-frame product and inside tests in blocks, parallel_blocks). Each
 // piece does the same arithmetic whichever thread runs it, so results are bit-identical whatever
 // the thread count.
 //
@@ -71,7 +72,8 @@ class Task {
 // `min_block` items and runs fn(begin, end) on each: the first block on the calling thread, the
 // others as tasks; returns when all are done (rethrowing the first block's exception, else a
 // task's). fn must write disjoint outputs and compute each item the same way whatever its block,
-// so the results do not depend on the thread count. fn must not report progress.
+// so the results do not depend on the thread count. Only the first block (begin == 0) runs on the
+// calling thread, so only it may report progress (mean_value_coordinates does so).
 void parallel_blocks(long n, long min_block, const std::function<void(long begin, long end)>& fn);
 
 }  // namespace mm

@@ -289,10 +289,10 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
   // Supernodes the calling thread factors in order (all of them, or the top of the tree once the
   // subtrees below are done).
   std::vector<int> sequence;
-  // Two threads (when the build has them, on large systems): the elimination tree is cut into disjoint subtrees
-  // (the largest split into its children until none holds 45 % of the work; their postorder
-  // ranges are contiguous) shared out by work between this thread and a second one; the
-  // supernodes above them follow here. Measured on the 48k-unknown Eq. 7 system of michael3:
+  // Two threads (when the build has them, on large systems): the elimination tree is cut into
+  // disjoint subtrees (the largest split into its children until none holds 45 % of the work;
+  // their postorder ranges are contiguous) shared out by work between this thread and a second
+  // one; the supernodes above them follow here. Measured on the 48k-unknown Eq. 7 system of michael3:
   // 26 % of the flops above the cut, 37 / 37 % below.
   // (The single-threaded wasm build always takes the sequential path.)
   bool split = false;

@@ -66,28 +66,28 @@ Eigen::MatrixXd transposed_times_n3(const Eigen::MatrixXd& Mt, const Eigen::Matr
   // threads (the per-frame vertex product of the retargeter; bit-identical for any split).
   const long min_cols = std::max<long>(1, 100000 / std::max<long>(1, 3 * static_cast<long>(k)));
   parallel_blocks(static_cast<long>(n), min_cols, [&](long begin, long end) {
-  for (Eigen::Index j = begin; j < end; ++j) {
-    const double* m = Mt.col(j).data();
-    double x0 = 0, y0 = 0, z0 = 0, x1 = 0, y1 = 0, z1 = 0;  // two chains for instruction-level parallelism
-    Eigen::Index i = 0;
-    for (; i + 1 < k; i += 2) {
-      const double* p = &b[3 * i];
-      x0 += m[i] * p[0];
-      y0 += m[i] * p[1];
-      z0 += m[i] * p[2];
-      x1 += m[i + 1] * p[3];
-      y1 += m[i + 1] * p[4];
-      z1 += m[i + 1] * p[5];
+    for (Eigen::Index j = begin; j < end; ++j) {
+      const double* m = Mt.col(j).data();
+      double x0 = 0, y0 = 0, z0 = 0, x1 = 0, y1 = 0, z1 = 0;  // two chains for instruction-level parallelism
+      Eigen::Index i = 0;
+      for (; i + 1 < k; i += 2) {
+        const double* p = &b[3 * i];
+        x0 += m[i] * p[0];
+        y0 += m[i] * p[1];
+        z0 += m[i] * p[2];
+        x1 += m[i + 1] * p[3];
+        y1 += m[i + 1] * p[4];
+        z1 += m[i + 1] * p[5];
+      }
+      if (i < k) {
+        x0 += m[i] * b[3 * i];
+        y0 += m[i] * b[3 * i + 1];
+        z0 += m[i] * b[3 * i + 2];
+      }
+      out(j, 0) = x0 + x1;
+      out(j, 1) = y0 + y1;
+      out(j, 2) = z0 + z1;
     }
-    if (i < k) {
-      x0 += m[i] * b[3 * i];
-      y0 += m[i] * b[3 * i + 1];
-      z0 += m[i] * b[3 * i + 2];
-    }
-    out(j, 0) = x0 + x1;
-    out(j, 1) = y0 + y1;
-    out(j, 2) = z0 + z1;
-  }
   });
   return out;
 }

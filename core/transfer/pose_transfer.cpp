@@ -127,8 +127,7 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
     Eigen::MatrixXi CF;
     double ms_cage = 0, ms_mvc = 0;
   };
-  auto cage_stage = [&source, &src, &opt, user_cage](const Progress& cage_progress, const Progress& mvc_progress,
-                                                      bool threaded) {
+  auto cage_stage = [&source, &src, &opt, user_cage](const Progress& cage_progress, const Progress& mvc_progress) {
     CageStage r;
     auto t = clock::now();
     if (user_cage) {
@@ -149,36 +148,9 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
     // Mean-value coordinates are similarity invariant: computed in normalized coordinates.
     t = clock::now();
     r.Cn = (r.C.rowwise() - src.centroid) / src.scale;
-    MeanValueCoordinates mvc;
-#if MM_HAS_THREADS
-    if (threaded && max_threads() > 1 && src.V.rows() >= 2048) {
-      // Rows of Ψ are independent: computed in blocks of rows, all but the first as tasks (the
-      // calling thread takes one once it only waits for the cage; common/threads.h).
-      const Eigen::Index n = src.V.rows();
-      const int blocks = std::min<int>(max_threads(), kMaxPoolThreads + 1);
-      std::vector<MeanValueCoordinates> part(static_cast<size_t>(blocks));
-      auto rows_of = [&](int b) { return std::make_pair(n * b / blocks, n * (b + 1) / blocks); };
-      std::vector<Task> rest;
-      for (int b = 1; b < blocks; ++b)
-        rest.emplace_back([&, b] {
-          const auto [begin, end] = rows_of(b);
-          part[b] = mean_value_coordinates(src.V.middleRows(begin, end - begin), r.Cn, r.CF, mvc_progress);
-        });
-      part[0] = mean_value_coordinates(src.V.topRows(rows_of(0).second), r.Cn, r.CF, mvc_progress);
-      for (Task& t : rest) t.wait();
-      mvc.status = Status::success();
-      for (const MeanValueCoordinates& p : part)
-        if (mvc.status.ok() && !p.status.ok()) mvc.status = p.status;
-      if (mvc.status.ok()) {
-        mvc.Psi.resize(n, r.Cn.rows());
-        for (int b = 0; b < blocks; ++b) mvc.Psi.middleRows(rows_of(b).first, part[b].Psi.rows()) = part[b].Psi;
-      }
-    } else
-#endif
-    {
-      (void)threaded;
-      mvc = mean_value_coordinates(src.V, r.Cn, r.CF, mvc_progress);
-    }
+    // (Its rows are split across the task threads inside; the calling thread takes a block once
+    // it only waits for the cage.)
+    MeanValueCoordinates mvc = mean_value_coordinates(src.V, r.Cn, r.CF, mvc_progress);
     if (!mvc.status.ok()) {
       r.status = mvc.status;
       return r;
@@ -208,7 +180,7 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
       report.recorded = true;
       return !stop_cage.load();
     });
-    cage_task = Task([&cage_result, cage_stage, watch] { cage_result = cage_stage(watch.sub(0.0, 0.45), watch.sub(0.45, 1.0), true); });
+    cage_task = Task([&cage_result, cage_stage, watch] { cage_result = cage_stage(watch.sub(0.0, 0.45), watch.sub(0.45, 1.0)); });
   }
 #endif
   // Whatever returns early below stops the cage task first (the task's destructor then waits).
@@ -283,8 +255,8 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
   if (opt.method != TransferMethod::Yin) {
     Vn = src.V + PhiK_src * (alpha_ref - alpha_src);  // Eq. 4
   } else {
-    // Wait for the cage task, reporting its progress from here every 40 ms (and running the
-    // mean-value rows' second half when it is queued).
+    // Wait for the cage task, reporting its progress from here every 40 ms (and running a block
+    // of the mean-value rows when one is queued).
     const bool cage_threaded = cage_task.valid();
     if (cage_threaded) {
       bool done = false;
@@ -302,7 +274,7 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
       }
     }
     CageStage cs = cage_threaded ? std::move(cage_result)
-                                 : cage_stage(progress.sub(0.4, 0.6), progress.sub(0.6, 0.85), false);
+                                 : cage_stage(progress.sub(0.4, 0.6), progress.sub(0.6, 0.85));
     if (!cs.status.ok()) {
       out.status = cs.status;
       return out;
