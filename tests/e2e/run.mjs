@@ -1390,6 +1390,29 @@ it('recovery: a 1M-vertex mesh, a full wasm heap and a dead worker never take th
 registerMergeTests(it, { check, shot, nextFrame, waitIdle, canvasPixels, pixelStats, repoDir, shotDir, cliPath });
 registerRetargetTests(it, { check, shot, nextFrame, waitIdle, canvasPixels, pixelStats, repoDir, shotDir, cliPath, record });
 
+// The Open… pickers of the two-mesh jobs (the other cases load bundled samples): a person's own
+// PLY pair into Transfer and a mesh into Merge's source, through the file inputs.
+it('transfer: the Open… pickers take the person\'s own files (Transfer and Merge)', async ({ page }) => {
+  await page.waitForFunction(() => window.__meshmorph.state.loads >= 1, null, { timeout: 60000 });
+  await waitIdle(page);  // the pickers are disabled while the worker is busy
+  await page.click('#jobs button[data-job="transfer"]');
+  await page.setInputFiles('#tr-reference-file', path.join(repoDir, 'data/pose/cat-07.ply'));
+  await page.waitForFunction(() => window.__meshmorph.state.transfer.reference?.name === 'cat-07.ply' || window.__meshmorph.state.error, null, { timeout: 60000 });
+  await page.setInputFiles('#tr-source-file', path.join(repoDir, 'data/pose/cat-reference.ply'));
+  await page.waitForFunction(() => window.__meshmorph.state.transfer.source?.name === 'cat-reference.ply' || window.__meshmorph.state.error, null, { timeout: 60000 });
+  await waitIdle(page);
+  const t = await page.evaluate(() => ({ ref: window.__meshmorph.state.transfer.reference, src: window.__meshmorph.state.transfer.source, same: window.__meshmorph.state.transfer.sameConnectivity, error: window.__meshmorph.state.error }));
+  check(!t.error && t.ref?.weldedVertices === 7207 && t.src?.weldedVertices === 7207 && t.same, `transfer pickers: ${JSON.stringify(t)}`);
+  await shot(page, '16-transfer-own-files');
+  await page.click('#jobs button[data-job="merge"]');
+  await waitIdle(page);
+  await page.setInputFiles('#mg-source-file', path.join(repoDir, 'data/edit/camelhead.ply'));
+  await page.waitForFunction(() => window.__meshmorph.state.merge.source?.name === 'camelhead.ply' || window.__meshmorph.state.error, null, { timeout: 60000 });
+  await waitIdle(page);
+  check(!(await page.evaluate(() => window.__meshmorph.state.error)), `merge picker: ${JSON.stringify(await page.evaluate(() => window.__meshmorph.state.error))}`);
+  await shot(page, '16-merge-own-file');
+});
+
 it('no console warnings or errors during the run', async ({ allConsole }) => {
   check(allConsole.length === 0, `${allConsole.length} console lines:\n${allConsole.slice(0, 20).join('\n')}`);
 });

@@ -504,7 +504,7 @@ export const panel = {
       });
       const input = $(`mg-${side}-file`);
       input.addEventListener('change', async () => {
-        const list = input.files;
+        const list = [...input.files]; // a copy: clearing the input empties its FileList
         input.value = '';
         if (!list.length) return;
         try {

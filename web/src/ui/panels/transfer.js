@@ -346,7 +346,7 @@ export const panel = {
       });
       const input = $(`tr-${side}-file`);
       input.addEventListener('change', async () => {
-        const list = input.files;
+        const list = [...input.files]; // a copy: clearing the input empties its FileList
         input.value = '';
         if (!list.length) return;
         try {
