@@ -4,7 +4,9 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <Eigen/QR>
 
+#include "linalg/block_lanczos.h"
 #include "linalg/polar.h"
 #include "linalg/spd_solver.h"
 #include "operators/operators.h"
@@ -81,6 +83,55 @@ TEST(Polar, ReflectionAndRankDeficiencyStillGiveProperRotations) {
   Eigen::Matrix3d bad = Eigen::Matrix3d::Identity();
   bad(1, 2) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_TRUE(polar_decomposition(bad).R.isIdentity());
+}
+
+// Block Lanczos on a dense symmetric operator with a known spectrum: a 12-fold top eigenvalue
+// (three times the block size), a close pair, and a long tail; then a rank-3 operator, whose
+// Krylov space runs out after one block (the rank-loss path), and a cancel.
+TEST(BlockLanczos, KnownSpectrumWithMultipletsLargerThanTheBlock) {
+  const int n = 400;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> g;
+  Eigen::MatrixXd G(n, n);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) G(i, j) = g(rng);
+  const Eigen::MatrixXd U = Eigen::HouseholderQR<Eigen::MatrixXd>(G).householderQ();
+  Eigen::VectorXd d(n);
+  for (int i = 0; i < n; ++i) d[i] = i < 12 ? 10.0 : i == 12 ? 7.0 : i == 13 ? 7.0 - 1e-7 : 6.0 * std::pow(0.99, i);
+  const Eigen::MatrixXd Op = U * d.asDiagonal() * U.transpose();
+  BlockLanczosOptions o;
+  o.nev = 16;
+  o.block = 4;
+  int calls = 0;
+  const BlockLanczosResult r = block_lanczos(
+      n, [&](const Eigen::MatrixXd& X, Eigen::MatrixXd* Y) { ++calls; *Y = Op * X; return true; }, o);
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
+  ASSERT_EQ(r.values.size(), 16);
+  for (int i = 0; i < 16; ++i) EXPECT_NEAR(r.values[i], d[i], 1e-9) << i;
+  EXPECT_LT((r.vectors.transpose() * r.vectors - Eigen::MatrixXd::Identity(16, 16)).cwiseAbs().maxCoeff(), 1e-10);
+  for (int i = 0; i < 16; ++i) EXPECT_LT((Op * r.vectors.col(i) - r.values[i] * r.vectors.col(i)).norm(), 1e-8) << i;
+  EXPECT_EQ(r.applications, 4 * calls);
+
+  // Rank 3: after the first block the rest of the space is Op's null space.
+  const Eigen::MatrixXd Low = U.leftCols(3) * Eigen::Vector3d(3, 2, 1).asDiagonal() * U.leftCols(3).transpose();
+  o.nev = 3;
+  const BlockLanczosResult low = block_lanczos(
+      n, [&](const Eigen::MatrixXd& X, Eigen::MatrixXd* Y) { *Y = Low * X; return true; }, o);
+  ASSERT_TRUE(low.status.ok()) << low.status.message;
+  EXPECT_NEAR(low.values[0], 3, 1e-10);
+  EXPECT_NEAR(low.values[1], 2, 1e-10);
+  EXPECT_NEAR(low.values[2], 1, 1e-10);
+  EXPECT_TRUE(low.vectors.allFinite());
+
+  // Cancel on the third block; too small a space is refused.
+  calls = 0;
+  const BlockLanczosResult c = block_lanczos(
+      n, [&](const Eigen::MatrixXd& X, Eigen::MatrixXd* Y) { *Y = Op * X; return ++calls < 3; }, o);
+  EXPECT_EQ(c.status.code, StatusCode::Cancelled);
+  EXPECT_EQ(calls, 3);
+  o.nev = 200;
+  EXPECT_EQ(block_lanczos(n, [&](const Eigen::MatrixXd& X, Eigen::MatrixXd* Y) { *Y = Op * X; return true; }, o).status.code,
+            StatusCode::InvalidArgument);
 }
 
 }  // namespace mm

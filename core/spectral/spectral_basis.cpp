@@ -5,10 +5,13 @@
 #include <numeric>
 #include <stdexcept>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <Spectra/MatOp/SparseSymMatProd.h>
 #include <Spectra/SymGEigsShiftSolver.h>
 
+#include "linalg/block_lanczos.h"
+#include "linalg/supernodal_cholesky.h"
 #include "operators/operators.h"
 
 namespace mm {
@@ -51,22 +54,6 @@ class ShiftInvertLdlt {
 
   int ops() const { return ops_; }
 
-  // The number of eigenvalues of W φ = λ A φ below tau: the negative pivots of LDLᵀ(W - τA)
-  // (Sylvester's law of inertia); the symbolic analysis is shared by every call. -1 if the
-  // factorization breaks down (an exact zero pivot).
-  int count_below(double tau) {
-    Eigen::SparseMatrix<double> M = W_ - tau * A_;
-    if (!sturm_analyzed_) {
-      sturm_.analyzePattern(M);
-      sturm_analyzed_ = true;
-    }
-    sturm_.factorize(M);
-    if (sturm_.info() != Eigen::Success) return -1;
-    const Eigen::VectorXd d = sturm_.vectorD();
-    if (!d.allFinite()) return -1;
-    return static_cast<int>((d.array() < 0).count());
-  }
-
  private:
   const Eigen::SparseMatrix<double>& W_;
   const Eigen::SparseMatrix<double>& A_;
@@ -75,10 +62,115 @@ class ShiftInvertLdlt {
   mutable int ops_ = 0;
   double sigma_ = 0;
   bool factored_ = false;
-  bool sturm_analyzed_ = false;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> sturm_;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt_;
 };
+
+// The number of eigenvalues of W φ = λ A φ below tau: the negative pivots of LDLᵀ(W - τA)
+// (Sylvester's law of inertia); the symbolic analysis is shared by every call. -1 if the
+// factorization breaks down (an exact zero pivot).
+class InertiaCount {
+ public:
+  InertiaCount(const Eigen::SparseMatrix<double>& W, const Eigen::SparseMatrix<double>& A) : W_(W), A_(A) {}
+  int below(double tau) {
+    Eigen::SparseMatrix<double> M = W_ - tau * A_;
+    if (!analyzed_) {
+      ldlt_.analyzePattern(M);
+      analyzed_ = true;
+    }
+    ldlt_.factorize(M);
+    if (ldlt_.info() != Eigen::Success) return -1;
+    const Eigen::VectorXd d = ldlt_.vectorD();
+    if (!d.allFinite()) return -1;
+    return static_cast<int>((d.array() < 0).count());
+  }
+
+ private:
+  const Eigen::SparseMatrix<double>& W_;
+  const Eigen::SparseMatrix<double>& A_;
+  bool analyzed_ = false;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt_;
+};
+
+// One Lanczos run for nev pairs of W φ = λ A φ near σ, unsorted.
+struct LanczosRun {
+  Status status;
+  Eigen::VectorXd values;
+  Eigen::MatrixXd vectors;  // A-orthonormal
+  int iterations = 0;
+};
+
+LanczosRun run_spectra(ShiftInvertLdlt& op, const Eigen::SparseMatrix<double>& A, int n, int nev, double sigma,
+                       const SpectralBasisOptions& opt) {
+  LanczosRun run;
+  const int ncv = opt.ncv > 0 ? std::min(n, std::max(opt.ncv, nev + 1)) : std::min(n, std::max(2 * nev + 1, nev + 20));
+  Spectra::SparseSymMatProd<double> bop(A);
+  try {
+    Spectra::SymGEigsShiftSolver<ShiftInvertLdlt, Spectra::SparseSymMatProd<double>, Spectra::GEigsMode::ShiftInvert>
+        solver(op, bop, nev, ncv, sigma);
+    solver.init();
+    solver.compute(Spectra::SortRule::LargestMagn, opt.max_iterations, opt.tolerance, Spectra::SortRule::SmallestAlge);
+    run.iterations = static_cast<int>(solver.num_iterations());
+    if (solver.info() != Spectra::CompInfo::Successful) {
+      run.status = Status::error(StatusCode::NotConverged, "eigensolver did not converge in " +
+                                                               std::to_string(opt.max_iterations) +
+                                                               " restarts (k = " + std::to_string(opt.k) + ")");
+      return run;
+    }
+    run.values = solver.eigenvalues();
+    run.vectors = solver.eigenvectors();
+  } catch (const CancelRequested&) {
+    run.status = cancelled_status("eigenbasis");
+  } catch (const std::exception& e) {
+    run.status = Status::error(StatusCode::FactorizationFailed, std::string("eigensolver: ") + e.what());
+  }
+  return run;
+}
+
+// Shift-invert in symmetric form: with D = A^½ and y = D φ, the pairs are the largest θ of
+// D (W - σA)⁻¹ D y = θ y, λ = σ + 1/θ (W - σA is SPD for σ < 0: one supernodal Cholesky).
+LanczosRun run_block(const SupernodalCholesky& chol, const Eigen::VectorXd& d, int nev, const SpectralBasisOptions& opt,
+                     const Progress& progress, double sigma, int* applications) {
+  LanczosRun run;
+  const int n = static_cast<int>(d.size());
+  BlockLanczosOptions bo;
+  bo.nev = nev;
+  bo.block = opt.block;
+  bo.max_dim = opt.ncv;
+  bo.tolerance = opt.tolerance;
+  bo.max_restarts = opt.max_iterations;
+  const double expected = 3.0 * std::max(2 * nev + 1, nev + 20);
+  const BlockLanczosResult r = block_lanczos(
+      n,
+      [&](const Eigen::MatrixXd& X, Eigen::MatrixXd* Y) {
+        *Y = d.asDiagonal() * X;
+        chol.solve_in_place(*Y);
+        *Y = d.asDiagonal() * *Y;
+        *applications += static_cast<int>(X.cols());
+        return progress.update("eigenbasis", 1.0 - std::exp(-*applications / expected));
+      },
+      bo);
+  run.status = r.status;
+  run.iterations = r.restarts;
+
+  if (!r.status.ok()) return run;
+  run.values = (sigma + r.values.array().inverse()).matrix();
+  run.vectors = d.cwiseInverse().asDiagonal() * r.vectors;
+  return run;
+}
+
+// Small meshes: every pair at once (D⁻¹ W D⁻¹ is n by n), complete by construction.
+LanczosRun run_dense(const Eigen::SparseMatrix<double>& W, const Eigen::VectorXd& d) {
+  LanczosRun run;
+  const Eigen::MatrixXd Wd = d.cwiseInverse().asDiagonal() * Eigen::MatrixXd(W) * d.cwiseInverse().asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Wd);
+  if (es.info() != Eigen::Success) {
+    run.status = Status::error(StatusCode::NotConverged, "dense eigensolver did not converge");
+    return run;
+  }
+  run.values = es.eigenvalues();
+  run.vectors = d.cwiseInverse().asDiagonal() * es.eigenvectors();
+  return run;
+}
 
 }  // namespace
 
@@ -115,56 +207,70 @@ SpectralBasis spectral_basis(const Eigen::SparseMatrix<double>& W, const Eigen::
   // the pairs needed, then counts the eigenvalues below τ (just above λ_{k-1}) exactly: by
   // Sylvester's law of inertia, the negative pivots of LDLᵀ(W - τA). If the count exceeds the
   // computed values below τ, some were missed: the next pass asks for more.
-  ShiftInvertLdlt op(W, A, progress, 3 * std::min(n, std::max(2 * opt.k + 1, opt.k + 20)));
-  Spectra::SparseSymMatProd<double> bop(A);
-  const double tau_floor = std::abs(sigma);  // the scale at which λ₀ = 0 is told apart
-  int nev = opt.k;
-  Eigen::VectorXd sorted;
-  for (int pass = 0;; ++pass) {
-    const int ncv = opt.ncv > 0 ? std::min(n, std::max(opt.ncv, nev + 1))
-                                : std::min(n, std::max(2 * nev + 1, nev + 20));
-    try {
-      Spectra::SymGEigsShiftSolver<ShiftInvertLdlt, Spectra::SparseSymMatProd<double>,
-                                   Spectra::GEigsMode::ShiftInvert>
-          solver(op, bop, nev, ncv, sigma);
-      solver.init();
-      solver.compute(Spectra::SortRule::LargestMagn, opt.max_iterations, opt.tolerance,
-                     Spectra::SortRule::SmallestAlge);
-      out.iterations += static_cast<int>(solver.num_iterations());
-      if (solver.info() != Spectra::CompInfo::Successful) {
-        out.status = Status::error(StatusCode::NotConverged,
-                                   "eigensolver did not converge in " + std::to_string(opt.max_iterations) +
-                                       " restarts (k = " + std::to_string(opt.k) + ")");
+  const Eigen::VectorXd d = mass.cwiseSqrt();
+  const double basis_mib = static_cast<double>(n) * (2.0 * opt.k + 1) * 8.0 / (1 << 20);
+  const bool spectra = opt.solver == EigenSolverKind::Spectra ||
+                       (opt.solver == EigenSolverKind::Auto && basis_mib < opt.block_min_basis_mib);
+  // The block solver needs n ≥ its Krylov space plus a block; smaller meshes are solved densely.
+  const int block_min_n = 4 * std::max(opt.k + 24, 2 * opt.k + 24);
+  if (n <= opt.dense_max_vertices || (!spectra && n < block_min_n)) {
+    LanczosRun run = run_dense(W, d);
+    if (!run.status.ok()) {
+      out.status = run.status;
+      return out;
+    }
+    out.eigenvalues = run.values;
+    out.vectors = run.vectors;
+    out.passes = 1;
+  } else {
+    ShiftInvertLdlt op(W, A, progress, 3 * std::min(n, std::max(2 * opt.k + 1, opt.k + 20)));
+    SupernodalCholesky chol;
+    if (!spectra) {
+      const Eigen::SparseMatrix<double> M = W - sigma * A;
+      const Status fs = chol.factor(M, progress.sub(0.0, 0.05));
+
+      if (!fs.ok()) {
+        out.status = fs.code == StatusCode::Cancelled
+                         ? cancelled_status("eigenbasis")
+                         : Status::error(StatusCode::FactorizationFailed, "eigensolver: factorization of W - sigma A failed (" + fs.message + ")");
         return out;
       }
-      out.eigenvalues = solver.eigenvalues();
-      out.vectors = solver.eigenvectors();
-    } catch (const CancelRequested&) {
-      out.status = cancelled_status("eigenbasis");
-      return out;
-    } catch (const std::exception& e) {
-      out.status = Status::error(StatusCode::FactorizationFailed, std::string("eigensolver: ") + e.what());
-      return out;
     }
-    out.passes = pass + 1;
-    out.operations = op.ops();
-    sorted = out.eigenvalues;
-    std::sort(sorted.data(), sorted.data() + sorted.size());
-    const double lam = sorted[opt.k - 1];
-    double tau = lam + std::max(opt.cluster_gap * std::abs(lam), tau_floor);
-    if (opt.k < sorted.size()) tau = std::min(tau, 0.5 * (lam + sorted[opt.k]));
-    const int computed = static_cast<int>(std::lower_bound(sorted.data(), sorted.data() + sorted.size(), tau) - sorted.data());
-    const int below = op.count_below(tau);
-    if (below < 0 || below <= computed) break;  // complete (or the count failed: keep the old guarantee)
-    if (pass >= 3 || nev >= n - 1) {
-      out.status = Status::error(StatusCode::NotConverged,
-                                 "eigensolver: " + std::to_string(below) + " eigenvalues lie below " +
-                                     std::to_string(tau) + " but Lanczos found " + std::to_string(computed) +
-                                     " after " + std::to_string(pass + 1) + " passes (k = " + std::to_string(opt.k) + ")");
-      return out;
+    InertiaCount inertia(W, A);
+    const double tau_floor = std::abs(sigma);  // the scale at which λ₀ = 0 is told apart
+    int nev = opt.k, applications = 0;
+    Eigen::VectorXd sorted;
+    for (int pass = 0;; ++pass) {
+      LanczosRun run = spectra ? run_spectra(op, A, n, nev, sigma, opt)
+                               : run_block(chol, d, nev, opt, progress.sub(0.05, 1.0), sigma, &applications);
+      out.iterations += run.iterations;
+      if (!run.status.ok()) {
+        out.status = run.status;
+        return out;
+      }
+      out.eigenvalues = run.values;
+      out.vectors = run.vectors;
+      out.passes = pass + 1;
+      out.operations = spectra ? op.ops() : applications;
+      sorted = out.eigenvalues;
+      std::sort(sorted.data(), sorted.data() + sorted.size());
+      const double lam = sorted[opt.k - 1];
+      double tau = lam + std::max(opt.cluster_gap * std::abs(lam), tau_floor);
+      if (opt.k < sorted.size()) tau = std::min(tau, 0.5 * (lam + sorted[opt.k]));
+      const int computed = static_cast<int>(std::lower_bound(sorted.data(), sorted.data() + sorted.size(), tau) - sorted.data());
+      const int below = inertia.below(tau);
+
+      if (below < 0 || below <= computed) break;  // complete (or the count failed: keep the old guarantee)
+      if (pass >= 3 || nev >= n - 1) {
+        out.status = Status::error(StatusCode::NotConverged,
+                                   "eigensolver: " + std::to_string(below) + " eigenvalues lie below " +
+                                       std::to_string(tau) + " but Lanczos found " + std::to_string(computed) +
+                                       " after " + std::to_string(pass + 1) + " passes (k = " + std::to_string(opt.k) + ")");
+        return out;
+      }
+      out.missed += below - computed;
+      nev = std::min(n - 1, std::max(nev, below) + std::max(5, opt.k / 10));
     }
-    out.missed += below - computed;
-    nev = std::min(n - 1, std::max(nev, below) + std::max(5, opt.k / 10));
   }
 
   // Ascending order (stable, so ties keep Spectra's deterministic order).

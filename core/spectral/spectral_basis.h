@@ -18,24 +18,39 @@
 
 namespace mm {
 
+// The Lanczos behind the shift-invert solve: our block Lanczos (linalg/block_lanczos.h: blocks of
+// solves through the supernodal factor, reorthogonalisation as matrix–matrix products) or Spectra's
+// one-vector Lanczos through SimplicialLDLT (the peer's configuration). Auto picks by the size of
+// the Krylov basis, n·(2k + 1) doubles: Spectra's matrix–vector reorthogonalisation is fast while
+// the basis stays in the last-level cache, and memory-bound beyond it, where the block solver's
+// matrix–matrix products win despite needing ~1.5× the solves (docs/bench.md, thirteenth session:
+// k = 100 at 52k vertices 5.5 → 2.8 s; at 11k, a 18 MB basis, Spectra 0.45 s vs block 0.6 s).
+enum class EigenSolverKind { Auto, BlockLanczos, Spectra };
+
 struct SpectralBasisOptions {
   int k = 20;                 // number of eigenpairs; 1 ≤ k < #V
-  int ncv = 0;                // Krylov subspace size; 0 = min(#V, max(2m + 1, m + 20)) with m
-                              // the pairs asked for: k, more in a pass after missed eigenvalues
+  EigenSolverKind solver = EigenSolverKind::Auto;
+  double block_min_basis_mib = 24;  // Auto: block Lanczos when n·(2k + 1)·8 bytes exceed this
+  int block = 0;              // block Lanczos: vectors per block (0 = clamp(m / 12, 4, 8))
+  int ncv = 0;                // Krylov subspace size before a restart; 0 = min(#V, max(2m + 1, m + 20))
+                              // for Spectra, 2m + 2b for block Lanczos, with m the pairs asked for:
+                              // k, more in a pass after missed eigenvalues. Meshes of at most
+                              // dense_max_vertices (or too small for the Krylov space) are solved densely.
+  int dense_max_vertices = 400;
   double cluster_gap = 1e-6;  // τ of the completeness count = λ_{k-1} (1 + cluster_gap), at least
                               // |σ| above it (and below the next computed eigenvalue)
   double relative_shift = 1e-6; // σ = -relative_shift · tr(W)/tr(A): W - σA is SPD even though
                               // W is singular, and σ sits just below λ₀ = 0 for fast convergence
-  double tolerance = 1e-10;   // Spectra's relative eigenvalue tolerance
-  int max_iterations = 1000;  // Spectra restarts before NotConverged
+  double tolerance = 1e-10;   // relative residual of each Ritz pair (Spectra's criterion, both solvers)
+  int max_iterations = 1000;  // restarts before NotConverged
 };
 
 struct SpectralBasis {
   Status status;
   Eigen::VectorXd eigenvalues; // k, ascending
   Eigen::MatrixXd vectors;     // #V by k, A-orthonormal columns
-  int iterations = 0;          // Spectra restarts used
-  int operations = 0;          // shift-invert solves performed
+  int iterations = 0;          // restarts used (0 for a dense solve)
+  int operations = 0;          // shift-invert solves performed (right-hand sides)
   int passes = 0;              // Lanczos runs: 1, or more when the inertia count found missed ones
   int missed = 0;              // eigenvalues the earlier passes missed (copies in multiplets)
 };
