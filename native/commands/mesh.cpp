@@ -51,13 +51,19 @@ int run_eigs(const std::vector<std::string>& argv) {
   SpectralBasisOptions opt;
   opt.k = args.get_int("k", opt.k, &s);
   opt.tolerance = args.get_double("tolerance", opt.tolerance, &s);
+  const std::string solver = args.get("solver", "auto");
+  if (solver == "block") opt.solver = EigenSolverKind::BlockLanczos;
+  else if (solver == "spectra") opt.solver = EigenSolverKind::Spectra;
+  else if (solver != "auto") s = Status::error(StatusCode::InvalidArgument, "--solver must be auto, block or spectra");
   const int show = args.get_int("show", 1, &s);
   const std::string out = args.get("out");
   if (!s.ok()) return report("eigs", s);
   if (args.has("help") || args.positional().size() != 1) {
     std::cout << "usage: meshmorph eigs FILE [-k " << SpectralBasisOptions{}.k << "] [--tolerance "
-              << SpectralBasisOptions{}.tolerance << "] [--out COLORS.glb --show I]\n"
+              << SpectralBasisOptions{}.tolerance << "] [--solver auto|block|spectra] [--out COLORS.glb --show I]\n"
               << "  the k smallest eigenpairs of W phi = lambda A phi (cotangent stiffness, Voronoi mass).\n"
+                 "  --solver: block Lanczos, Spectra's Lanczos, or auto (block when the Krylov basis of\n"
+                 "  n x (2k+1) doubles exceeds 20 MiB, where it is faster; spectral/spectral_basis.h).\n"
                  "  --out writes the mesh with eigenfunction I (default 1) as vertex colours (blue < 0 < red).\n";
     return args.has("help") ? 0 : 2;
   }
