@@ -9,6 +9,7 @@
 #include <Eigen/QR>
 
 #include "common/progress.h"
+#include "common/threads.h"
 
 namespace mm {
 
@@ -30,11 +31,45 @@ struct Random {
   }
 };
 
+// fn(begin, end) on the two halves of [0, n): the second as a task (another thread when
+// max_threads() > 1), so the split — and the bits — are the same on one thread or two.
+void in_two_halves(Eigen::Index n, const std::function<void(Eigen::Index, Eigen::Index)>& fn) {
+  const Eigen::Index h = n / 2;
+  Task second([&] { fn(h, n); });
+  fn(0, h);
+  second.wait();
+}
+
+// Qᵀ Y for the first m columns of Q, summed over the two row halves (the same order always).
+Eigen::MatrixXd project(const Eigen::MatrixXd& Q, int m, const Eigen::MatrixXd& Y) {
+  Eigen::MatrixXd P[2];
+  in_two_halves(Q.rows(), [&](Eigen::Index b, Eigen::Index e) {
+    P[b == 0 ? 0 : 1].noalias() = Q.block(b, 0, e - b, m).transpose() * Y.middleRows(b, e - b);
+  });
+  return P[0] + P[1];
+}
+
+// Y -= Q(:, c0 : c0 + m) P, by row halves.
+void subtract(const Eigen::MatrixXd& Q, int c0, int m, const Eigen::MatrixXd& P, Eigen::MatrixXd& Y) {
+  in_two_halves(Q.rows(), [&](Eigen::Index b, Eigen::Index e) {
+    Y.middleRows(b, e - b).noalias() -= Q.block(b, c0, e - b, m) * P;
+  });
+}
+
+// Q(:, 0:m) S by row halves.
+Eigen::MatrixXd combine(const Eigen::MatrixXd& Q, int m, const Eigen::MatrixXd& S) {
+  Eigen::MatrixXd out(Q.rows(), S.cols());
+  in_two_halves(Q.rows(), [&](Eigen::Index b, Eigen::Index e) {
+    out.middleRows(b, e - b).noalias() = Q.block(b, 0, e - b, m) * S;
+  });
+  return out;
+}
+
 // Y -= Q (Qᵀ Y); the coefficients are added to C (m by b) when given.
 void project_out(const Eigen::MatrixXd& Q, int m, Eigen::MatrixXd& Y, Eigen::MatrixXd* C) {
   if (m == 0) return;
-  const Eigen::MatrixXd P = Q.leftCols(m).transpose() * Y;
-  Y.noalias() -= Q.leftCols(m) * P;
+  const Eigen::MatrixXd P = project(Q, m, Y);
+  subtract(Q, 0, m, P, Y);
   if (C) C->topRows(m) += P;
 }
 
@@ -112,11 +147,11 @@ BlockLanczosResult block_lanczos(int n, const std::function<bool(const Eigen::Ma
       op_norm = std::max(op_norm, Y.colwise().norm().maxCoeff());
       C = Eigen::MatrixXd::Zero(m + b, b);
       // Local three-term step: Y -= X A + X_prev R_prevᵀ.
-      const Eigen::MatrixXd A = X.transpose() * Y;
-      Y.noalias() -= X * A;
+      const Eigen::MatrixXd A = project(X, b, Y);
+      subtract(X, 0, b, A, Y);
       C.bottomRows(b) += A;
       if (Bprev.cols() > 0) {
-        Y.noalias() -= Q.middleCols(prev_start, Bprev.cols()) * Bprev.transpose();
+        subtract(Q, prev_start, static_cast<int>(Bprev.cols()), Bprev.transpose(), Y);
         C.middleRows(prev_start, Bprev.cols()) += Bprev.transpose();
       }
       // Full reorthogonalisation against Q(:, 0 : m + b), twice if it took more than 1 − 1/√2 of
@@ -152,7 +187,7 @@ BlockLanczosResult block_lanczos(int n, const std::function<bool(const Eigen::Ma
       }
       if (converged == nev) {
         out.values = theta.head(nev);
-        out.vectors = Q.leftCols(m) * S.leftCols(nev);
+        out.vectors = combine(Q, m, S.leftCols(nev));
         return out;
       }
       if (full) break;
@@ -166,7 +201,7 @@ BlockLanczosResult block_lanczos(int n, const std::function<bool(const Eigen::Ma
     // nev + 30 % of the rest was 5–10 % faster than nev + 50 % (k = 100, 11k–52k vertices).
     ++out.restarts;
     const int p = std::min(m - b, std::max(nev + b, nev + (m - nev) * 3 / 10));
-    const Eigen::MatrixXd kept = Q.leftCols(m) * S.leftCols(p);
+    const Eigen::MatrixXd kept = combine(Q, m, S.leftCols(p));
     Q.leftCols(p) = kept;
     H.setZero();
     H.topLeftCorner(p, p).diagonal() = theta.head(p);
