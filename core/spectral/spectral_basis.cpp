@@ -231,6 +231,7 @@ SpectralBasis spectral_basis(const Eigen::SparseMatrix<double>& W, const Eigen::
     out.eigenvalues = run.values;
     out.vectors = run.vectors;
     out.passes = 1;
+    out.solver = "dense";
   } else {
     ShiftInvertLdlt op(W, A, progress, 3 * std::min(n, std::max(2 * opt.k + 1, opt.k + 20)));
     SupernodalCholesky chol;
@@ -246,6 +247,7 @@ SpectralBasis spectral_basis(const Eigen::SparseMatrix<double>& W, const Eigen::
       }
     }
     InertiaCount inertia(W, A);
+    out.solver = spectra ? "Spectra" : "block Lanczos";
     const double tau_floor = std::abs(sigma);  // the scale at which λ₀ = 0 is told apart
     int nev = opt.k, applications = 0;
     // Block Lanczos finds at most b copies of an exactly repeated eigenvalue (a Krylov space

@@ -52,6 +52,7 @@ struct SpectralBasis {
   int iterations = 0;          // restarts used (0 for a dense solve)
   int operations = 0;          // shift-invert solves performed (right-hand sides)
   int passes = 0;              // Lanczos runs: 1, or more when the inertia count found missed ones
+  const char* solver = "";     // which ran: "block Lanczos", "Spectra" or "dense"
   int missed = 0;              // eigenvalues the earlier passes missed (copies in multiplets)
 };
 
