@@ -119,6 +119,10 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
   rows_.clear();
   value_ptr_.assign(1, 0);
   values_.clear();
+  top_.clear();
+  first_.clear();
+  bins_[0].clear();
+  bins_[1].clear();
   if (n == 0) {
     factored_ = true;
     return Status::success();
@@ -322,12 +326,19 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     std::stable_sort(open.begin(), open.end(), [&](int x, int y) { return sub[x] > sub[y]; });
     std::vector<int> bins[2];
     double load[2] = {0, 0};
+    std::vector<int> bin_of(ns, -1);
     for (int x : open) {
       const int k = load[0] <= load[1] ? 0 : 1;
       load[k] += sub[x];
+      bin_of[x] = k;
       for (int t = first[x]; t <= x; ++t) bins[k].push_back(t);
     }
+    const auto load_bin_of = [&](int x) { return bin_of[x]; };
     for (int k = 0; k < 2; ++k) std::sort(bins[k].begin(), bins[k].end());
+    top_ = top;
+    first_ = first;
+    for (int x : open) bins_[load_bin_of(x)].push_back(x);
+    for (int k = 0; k < 2; ++k) std::sort(bins_[k].begin(), bins_[k].end());
     std::atomic<bool> stop{false};
     Status worker_status = Status::success();
     auto run = [&](const std::vector<int>& list, Scratch& w, Status* st) {
@@ -387,6 +398,13 @@ void SupernodalCholesky::solve_in_place(Eigen::MatrixXd& B) const {
   using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   RowMatrix Y(n_, k);
   for (int i = 0; i < n_; ++i) Y.row(perm_[i]) = B.row(i);
+#if MM_HAS_THREADS
+  if (!top_.empty() && max_threads() > 1) {
+    solve_split(Y);
+    for (int i = 0; i < n_; ++i) B.row(i) = Y.row(perm_[i]);
+    return;
+  }
+#endif
   const int ns = static_cast<int>(start_.size()) - 1;
   RowMatrix tmp;
   // Forward: L y = b.
@@ -414,6 +432,86 @@ void SupernodalCholesky::solve_in_place(Eigen::MatrixXd& B) const {
     L.topRows(ncols).triangularView<Eigen::Lower>().transpose().solveInPlace(Ys);
   }
   for (int i = 0; i < n_; ++i) B.row(i) = Y.row(perm_[i]);
+}
+
+// The solves on the factor's split. Forward: each thread runs its subtrees; an update aimed at a
+// row above its subtree (an ancestor above the cut) is logged instead of applied; then, in
+// postorder, the supernodes above the cut are solved and each subtree's log replayed at its
+// root's place — the same subtractions in the same order as the sequential solve. Backward: the
+// supernodes above the cut first (they read only their ancestors), then the subtrees on both
+// threads (they read their ancestors and write their own rows).
+void SupernodalCholesky::solve_split(Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& Y) const {
+  using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const int k = static_cast<int>(Y.cols());
+  const int ns = static_cast<int>(start_.size()) - 1;
+  struct Log {
+    std::vector<int> rows;
+    std::vector<double> values;
+  };
+  std::vector<Log> logs(ns);
+  // Forward on supernode s; rows at or above `limit` go to `log` (all applied when log is null).
+  const auto forward = [&](int s, RowMatrix& tmp, int limit, Log* log) {
+    const int f = start_[s], ncols = start_[s + 1] - f, nr = rows_ptr_[s + 1] - rows_ptr_[s], m = ncols + nr;
+    const Eigen::Map<const Eigen::MatrixXd> L(values_.data() + value_ptr_[s], m, ncols);
+    auto Ys = Y.middleRows(f, ncols);
+    L.topRows(ncols).triangularView<Eigen::Lower>().solveInPlace(Ys);
+    if (nr == 0) return;
+    tmp.noalias() = L.bottomRows(nr) * Ys;
+    const int* R = rows_.data() + rows_ptr_[s];
+    for (int a = 0; a < nr; ++a) {
+      if (log && R[a] >= limit) {
+        log->rows.push_back(R[a]);
+        log->values.insert(log->values.end(), tmp.row(a).data(), tmp.row(a).data() + k);
+      } else {
+        Y.row(R[a]) -= tmp.row(a);
+      }
+    }
+  };
+  const auto backward = [&](int s, RowMatrix& tmp) {
+    const int f = start_[s], ncols = start_[s + 1] - f, nr = rows_ptr_[s + 1] - rows_ptr_[s], m = ncols + nr;
+    const Eigen::Map<const Eigen::MatrixXd> L(values_.data() + value_ptr_[s], m, ncols);
+    auto Ys = Y.middleRows(f, ncols);
+    if (nr > 0) {
+      tmp.resize(nr, k);
+      const int* R = rows_.data() + rows_ptr_[s];
+      for (int a = 0; a < nr; ++a) tmp.row(a) = Y.row(R[a]);
+      Ys.noalias() -= L.bottomRows(nr).transpose() * tmp;
+    }
+    L.topRows(ncols).triangularView<Eigen::Lower>().transpose().solveInPlace(Ys);
+  };
+  const auto forward_bin = [&](int b) {
+    RowMatrix tmp;
+    for (int x : bins_[b])
+      for (int s = first_[x]; s <= x; ++s) forward(s, tmp, start_[x + 1], &logs[x]);
+  };
+  const auto backward_bin = [&](int b) {
+    RowMatrix tmp;
+    for (auto it = bins_[b].rbegin(); it != bins_[b].rend(); ++it)
+      for (int s = *it; s >= first_[*it]; --s) backward(s, tmp);
+  };
+  {
+    Task second([&] { forward_bin(1); });
+    forward_bin(0);
+    second.wait();
+  }
+  std::vector<char> root(ns, 0);
+  for (int b = 0; b < 2; ++b)
+    for (int x : bins_[b]) root[x] = 1;
+  RowMatrix tmp;
+  for (int s = 0; s < ns; ++s) {
+    if (root[s]) {
+      const Log& log = logs[s];
+      for (size_t e = 0; e < log.rows.size(); ++e)
+        Y.row(log.rows[e]) -= Eigen::Map<const Eigen::RowVectorXd>(log.values.data() + e * k, k);
+    } else if (top_[s]) {
+      forward(s, tmp, 0, nullptr);
+    }
+  }
+  for (int s = ns - 1; s >= 0; --s)
+    if (top_[s]) backward(s, tmp);
+  Task second([&] { backward_bin(1); });
+  backward_bin(0);
+  second.wait();
 }
 
 Status SupernodalCholesky::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd* X) const {

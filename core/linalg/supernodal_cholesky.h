@@ -40,7 +40,8 @@ class SupernodalCholesky {
   long factor_entries() const { return static_cast<long>(values_.size()); }  // stored (dense) entries of L
   int supernodes() const { return static_cast<int>(start_.size()) - 1; }
 
-  // X = A⁻¹ B for B n by k. NumericalError if the result is not finite.
+  // X = A⁻¹ B for B n by k. NumericalError if the result is not finite. A factor computed on two
+  // threads also solves on two (the subtrees below its cut; same bits as on one).
   Status solve(const Eigen::MatrixXd& B, Eigen::MatrixXd* X) const;
   // In place, unchecked (caller guarantees factored() and B.rows() == size()).
   void solve_in_place(Eigen::MatrixXd& B) const;
@@ -54,6 +55,12 @@ class SupernodalCholesky {
   std::vector<int> rows_;
   std::vector<long> value_ptr_;    // dense block of s: (ncols + nrows) by ncols, column-major
   std::vector<double> values_;
+  // The factor's two-thread split, kept for the solves (empty when it factored on one thread):
+  // supernodes above the cut, and per thread the subtrees (root s covers supernodes first_[s]..s).
+  std::vector<char> top_;
+  std::vector<int> first_;
+  std::vector<int> bins_[2];
+  void solve_split(Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& Y) const;
 };
 
 }  // namespace mm
