@@ -393,9 +393,8 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
 
 void SupernodalCholesky::solve_in_place(Eigen::MatrixXd& B) const {
   const int k = static_cast<int>(B.cols());
-  // Row-major work arrays: the gathers and scatters below touch whole rows (k values each), which
-  // are then contiguous instead of k cache lines apart.
-  using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  // Row-major work arrays: the gathers and scatters touch whole rows (k values each), which are
+  // then contiguous instead of k cache lines apart.
   RowMatrix Y(n_, k);
   for (int i = 0; i < n_; ++i) Y.row(perm_[i]) = B.row(i);
 #if MM_HAS_THREADS
@@ -407,31 +406,40 @@ void SupernodalCholesky::solve_in_place(Eigen::MatrixXd& B) const {
 #endif
   const int ns = static_cast<int>(start_.size()) - 1;
   RowMatrix tmp;
-  // Forward: L y = b.
-  for (int s = 0; s < ns; ++s) {
-    const int f = start_[s], ncols = start_[s + 1] - f, nr = rows_ptr_[s + 1] - rows_ptr_[s], m = ncols + nr;
-    const Eigen::Map<const Eigen::MatrixXd> L(values_.data() + value_ptr_[s], m, ncols);
-    auto Ys = Y.middleRows(f, ncols);
-    L.topRows(ncols).triangularView<Eigen::Lower>().solveInPlace(Ys);
-    if (nr == 0) continue;
-    tmp.noalias() = L.bottomRows(nr) * Ys;
-    const int* R = rows_.data() + rows_ptr_[s];
-    for (int a = 0; a < nr; ++a) Y.row(R[a]) -= tmp.row(a);
-  }
-  // Backward: Lᵀ x = y.
-  for (int s = ns - 1; s >= 0; --s) {
-    const int f = start_[s], ncols = start_[s + 1] - f, nr = rows_ptr_[s + 1] - rows_ptr_[s], m = ncols + nr;
-    const Eigen::Map<const Eigen::MatrixXd> L(values_.data() + value_ptr_[s], m, ncols);
-    auto Ys = Y.middleRows(f, ncols);
-    if (nr > 0) {
-      tmp.resize(nr, k);
-      const int* R = rows_.data() + rows_ptr_[s];
-      for (int a = 0; a < nr; ++a) tmp.row(a) = Y.row(R[a]);
-      Ys.noalias() -= L.bottomRows(nr).transpose() * tmp;
-    }
-    L.topRows(ncols).triangularView<Eigen::Lower>().transpose().solveInPlace(Ys);
-  }
+  for (int s = 0; s < ns; ++s) forward_supernode(s, Y, tmp, 0, nullptr);
+  for (int s = ns - 1; s >= 0; --s) backward_supernode(s, Y, tmp);
   for (int i = 0; i < n_; ++i) B.row(i) = Y.row(perm_[i]);
+}
+
+void SupernodalCholesky::forward_supernode(int s, RowMatrix& Y, RowMatrix& tmp, int limit, SolveLog* log) const {
+  const int f = start_[s], ncols = start_[s + 1] - f, nr = rows_ptr_[s + 1] - rows_ptr_[s], m = ncols + nr;
+  const Eigen::Map<const Eigen::MatrixXd> L(values_.data() + value_ptr_[s], m, ncols);
+  auto Ys = Y.middleRows(f, ncols);
+  L.topRows(ncols).triangularView<Eigen::Lower>().solveInPlace(Ys);
+  if (nr == 0) return;
+  tmp.noalias() = L.bottomRows(nr) * Ys;
+  const int* R = rows_.data() + rows_ptr_[s];
+  for (int a = 0; a < nr; ++a) {
+    if (log && R[a] >= limit) {
+      log->rows.push_back(R[a]);
+      log->values.insert(log->values.end(), tmp.row(a).data(), tmp.row(a).data() + Y.cols());
+    } else {
+      Y.row(R[a]) -= tmp.row(a);
+    }
+  }
+}
+
+void SupernodalCholesky::backward_supernode(int s, RowMatrix& Y, RowMatrix& tmp) const {
+  const int f = start_[s], ncols = start_[s + 1] - f, nr = rows_ptr_[s + 1] - rows_ptr_[s], m = ncols + nr;
+  const Eigen::Map<const Eigen::MatrixXd> L(values_.data() + value_ptr_[s], m, ncols);
+  auto Ys = Y.middleRows(f, ncols);
+  if (nr > 0) {
+    tmp.resize(nr, Y.cols());
+    const int* R = rows_.data() + rows_ptr_[s];
+    for (int a = 0; a < nr; ++a) tmp.row(a) = Y.row(R[a]);
+    Ys.noalias() -= L.bottomRows(nr).transpose() * tmp;
+  }
+  L.topRows(ncols).triangularView<Eigen::Lower>().transpose().solveInPlace(Ys);
 }
 
 // The solves on the factor's split. Forward: each thread runs its subtrees; an update aimed at a
@@ -440,54 +448,19 @@ void SupernodalCholesky::solve_in_place(Eigen::MatrixXd& B) const {
 // root's place — the same subtractions in the same order as the sequential solve. Backward: the
 // supernodes above the cut first (they read only their ancestors), then the subtrees on both
 // threads (they read their ancestors and write their own rows).
-void SupernodalCholesky::solve_split(Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& Y) const {
-  using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+void SupernodalCholesky::solve_split(RowMatrix& Y) const {
   const int k = static_cast<int>(Y.cols());
   const int ns = static_cast<int>(start_.size()) - 1;
-  struct Log {
-    std::vector<int> rows;
-    std::vector<double> values;
-  };
-  std::vector<Log> logs(ns);
-  // Forward on supernode s; rows at or above `limit` go to `log` (all applied when log is null).
-  const auto forward = [&](int s, RowMatrix& tmp, int limit, Log* log) {
-    const int f = start_[s], ncols = start_[s + 1] - f, nr = rows_ptr_[s + 1] - rows_ptr_[s], m = ncols + nr;
-    const Eigen::Map<const Eigen::MatrixXd> L(values_.data() + value_ptr_[s], m, ncols);
-    auto Ys = Y.middleRows(f, ncols);
-    L.topRows(ncols).triangularView<Eigen::Lower>().solveInPlace(Ys);
-    if (nr == 0) return;
-    tmp.noalias() = L.bottomRows(nr) * Ys;
-    const int* R = rows_.data() + rows_ptr_[s];
-    for (int a = 0; a < nr; ++a) {
-      if (log && R[a] >= limit) {
-        log->rows.push_back(R[a]);
-        log->values.insert(log->values.end(), tmp.row(a).data(), tmp.row(a).data() + k);
-      } else {
-        Y.row(R[a]) -= tmp.row(a);
-      }
-    }
-  };
-  const auto backward = [&](int s, RowMatrix& tmp) {
-    const int f = start_[s], ncols = start_[s + 1] - f, nr = rows_ptr_[s + 1] - rows_ptr_[s], m = ncols + nr;
-    const Eigen::Map<const Eigen::MatrixXd> L(values_.data() + value_ptr_[s], m, ncols);
-    auto Ys = Y.middleRows(f, ncols);
-    if (nr > 0) {
-      tmp.resize(nr, k);
-      const int* R = rows_.data() + rows_ptr_[s];
-      for (int a = 0; a < nr; ++a) tmp.row(a) = Y.row(R[a]);
-      Ys.noalias() -= L.bottomRows(nr).transpose() * tmp;
-    }
-    L.topRows(ncols).triangularView<Eigen::Lower>().transpose().solveInPlace(Ys);
-  };
+  std::vector<SolveLog> logs(ns);
   const auto forward_bin = [&](int b) {
     RowMatrix tmp;
     for (int x : bins_[b])
-      for (int s = first_[x]; s <= x; ++s) forward(s, tmp, start_[x + 1], &logs[x]);
+      for (int s = first_[x]; s <= x; ++s) forward_supernode(s, Y, tmp, start_[x + 1], &logs[x]);
   };
   const auto backward_bin = [&](int b) {
     RowMatrix tmp;
     for (auto it = bins_[b].rbegin(); it != bins_[b].rend(); ++it)
-      for (int s = *it; s >= first_[*it]; --s) backward(s, tmp);
+      for (int s = *it; s >= first_[*it]; --s) backward_supernode(s, Y, tmp);
   };
   {
     Task second([&] { forward_bin(1); });
@@ -500,15 +473,15 @@ void SupernodalCholesky::solve_split(Eigen::Matrix<double, Eigen::Dynamic, Eigen
   RowMatrix tmp;
   for (int s = 0; s < ns; ++s) {
     if (root[s]) {
-      const Log& log = logs[s];
+      const SolveLog& log = logs[s];
       for (size_t e = 0; e < log.rows.size(); ++e)
         Y.row(log.rows[e]) -= Eigen::Map<const Eigen::RowVectorXd>(log.values.data() + e * k, k);
     } else if (top_[s]) {
-      forward(s, tmp, 0, nullptr);
+      forward_supernode(s, Y, tmp, 0, nullptr);
     }
   }
   for (int s = ns - 1; s >= 0; --s)
-    if (top_[s]) backward(s, tmp);
+    if (top_[s]) backward_supernode(s, Y, tmp);
   Task second([&] { backward_bin(1); });
   backward_bin(0);
   second.wait();

@@ -60,7 +60,16 @@ class SupernodalCholesky {
   std::vector<char> top_;
   std::vector<int> first_;
   std::vector<int> bins_[2];
-  void solve_split(Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& Y) const;
+  using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  struct SolveLog {  // updates a subtree's forward solve aimed above the cut, in order
+    std::vector<int> rows;
+    std::vector<double> values;
+  };
+  void solve_split(RowMatrix& Y) const;
+  // One supernode of the forward (L y = b) and backward (Lᵀ x = y) solves on the permuted rows Y.
+  // Forward: updates of rows ≥ limit go to `log` instead of Y when a log is given.
+  void forward_supernode(int s, RowMatrix& Y, RowMatrix& tmp, int limit, SolveLog* log) const;
+  void backward_supernode(int s, RowMatrix& Y, RowMatrix& tmp) const;
 };
 
 }  // namespace mm
