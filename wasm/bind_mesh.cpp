@@ -32,10 +32,11 @@
 //   validateMesh(positions (#V·3), indices (#F·3), options? {degenerate_area_tolerance})
 //     → {ok: true, report, text}
 //   spectralBasis(positions (#V·3), indices (#F·3), options? {k, ncv, relative_shift,
-//                 tolerance, max_iterations}, progress?: (stage, fraction) => boolean)
+//                 tolerance, max_iterations, solver: 'auto'|'block'|'spectra'},
+//                 progress?: (stage, fraction) => boolean)
 //     → {ok, eigenvalues: Float64Array (k, ascending), vectors: Float32Array (k·#V; basis
 //        function i occupies [i·#V, (i+1)·#V), the layout the viewer slices), iterations,
-//        operations}. Returning false from progress cancels (code "Cancelled").
+//        operations, solver ('block Lanczos', 'Spectra' or 'dense')}. Returning false from progress cancels (code "Cancelled").
 //
 // Exceptions: core reports data errors as Status; a stray C++ exception (bad_alloc on a huge
 // file, a bug) is caught here and returned as code "Internal" so the worker stays usable.
@@ -329,6 +330,11 @@ val spectral_basis_js(const val& positions, const val& indices, const val& optio
   opt.relative_shift = get_number(options, "relative_shift", opt.relative_shift);
   opt.tolerance = get_number(options, "tolerance", opt.tolerance);
   opt.max_iterations = get_int(options, "max_iterations", opt.max_iterations);
+  const std::string solver = get_string(options, "solver", "auto");
+  if (solver == "block") opt.solver = EigenSolverKind::BlockLanczos;
+  else if (solver == "spectra") opt.solver = EigenSolverKind::Spectra;
+  else if (solver != "auto")
+    return status_object(Status::error(StatusCode::InvalidArgument, "solver must be 'auto', 'block' or 'spectra'"));
 
   const SpectralBasis basis = spectral_basis(V, F, opt, js_progress(progress));
   if (!basis.status.ok()) return status_object(basis.status);
@@ -338,6 +344,7 @@ val spectral_basis_js(const val& positions, const val& indices, const val& optio
   o.set("vectors", to_float32_array(basis.vectors.transpose()));
   o.set("iterations", basis.iterations);
   o.set("operations", basis.operations);
+  o.set("solver", std::string(basis.solver));
   return o;
 }
 

@@ -114,6 +114,33 @@ test('eigenbasis of the skull matches the C++ golden (spectral_eigs_skull: λ·a
   assert.ok(worst <= golden.tolerance, `largest difference ${worst} > tolerance ${golden.tolerance}`);
 });
 
+test('eigenbasis: the block Lanczos gives the skull golden too, reports progress and cancels', async () => {
+  const ctx = await makeContext();
+  ops.load(ctx, { name: 'skull.ply' }, fileBuffers('edit/skull.ply'));
+  const mesh = ctx.state.meshes.get('main');
+  const area = surfaceArea(mesh.weldedPositions, mesh.weldedIndices);
+  const golden = readGolden('spectral_eigs_skull');
+  const fractions = [];
+  const progressCtx = { ...ctx, progress: (stage, f) => { fractions.push(f); return true; } };
+  const block = ops.eigs(progressCtx, { k: 20, solver: 'block' });
+  const spectra = ops.eigs(ctx, { k: 20, solver: 'spectra' });
+  assert.equal(block.info.solver, 'block Lanczos');
+  assert.equal(spectra.info.solver, 'Spectra');
+  assert.ok(block.info.operations > spectra.info.operations, 'the block solver applies more vectors');
+  let worst = 0, apart = 0;
+  for (let i = 0; i < 20; ++i) {
+    worst = Math.max(worst, Math.abs(block.buffers.eigenvalues[i] * area - golden.data[i]));
+    apart = Math.max(apart, Math.abs(block.buffers.eigenvalues[i] - spectra.buffers.eigenvalues[i]) / (1 + spectra.buffers.eigenvalues[i]));
+  }
+  assert.ok(worst <= golden.tolerance, `largest difference ${worst} > tolerance ${golden.tolerance}`);
+  assert.ok(apart < 1e-10, `block and Spectra eigenvalues ${apart} apart`);
+  assert.ok(fractions.length > 3 && fractions.every((f) => f >= 0 && f <= 1));
+  let calls = 0;
+  expectCode(() => ops.eigs({ ...ctx, progress: () => ++calls < 4 }, { k: 20, solver: 'block' }), 'Cancelled');
+  assert.equal(calls, 4);
+  expectCode(() => ops.eigs(ctx, { k: 20, solver: 'lobpcg' }), 'InvalidArgument', /solver must be/);
+});
+
 test('eigenbasis: cancel through the progress callback, bad k, non-manifold input', async () => {
   const ctx = await makeContext();
   ops.load(ctx, { name: 'hand.ply' }, { 'hand.ply': dataBytes('edit/hand_lowres.ply') });

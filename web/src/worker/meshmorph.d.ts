@@ -47,6 +47,8 @@ export interface LoadOptions {
 /** core/spectral/spectral_basis.h SpectralBasisOptions. */
 export interface SpectralBasisOptions {
   k?: number; ncv?: number; relative_shift?: number; tolerance?: number; max_iterations?: number;
+  /** 'auto' (default): block Lanczos when the Krylov basis exceeds 20 MiB, else Spectra's. */
+  solver?: 'auto' | 'block' | 'spectra';
 }
 
 /** The Emscripten module (meshmorph_web.mjs in the worker, meshmorph_node.cjs in tests).
@@ -104,6 +106,7 @@ export interface MeshMorphModule {
     eigenvalues: Float64Array;  // k, ascending
     vectors: Float32Array;      // k·#V, function i at [i·#V, (i+1)·#V)
     iterations: number; operations: number;
+    solver: 'block Lanczos' | 'Spectra' | 'dense';
   }>;
   /** Automatic joints (wasm/bind_retarget.cpp, app/joints_job.h): the skinned source's joints
    *  fitted inside the target (glTF or mesh file). markersJson: {"joint": [x, y, z]} pins, or "".
@@ -155,8 +158,8 @@ export type Op = (ctx: OpContext, options: object, buffers: Buffers) => { buffer
 //          → {positions, indices, normals, toWelded} / {slot, name, format, warnings, primitives,
 //            report, text, infoReport, rawVertices, weldedVertices}
 // validate {slot?} or buffers {positions, indices} → {} / {slot, report, text}
-// eigs     {slot?, k?, ncv?, relative_shift?, tolerance?, max_iterations?}
-//          → {eigenvalues, vectors} / {slot, k, weldedVertices, iterations, operations, milliseconds}
+// eigs     {slot?, k?, ncv?, relative_shift?, tolerance?, max_iterations?, solver?}
+//          → {eigenvalues, vectors} / {slot, k, weldedVertices, iterations, operations, solver, milliseconds}
 // export   {slot?, format? = 'glb', recompute_normals?} + buffers {positions?}
 //          → {bytes} / {fileName, format, byteLength}
 // unload   {slot?} → {} / {slot, unloaded}

@@ -106,9 +106,9 @@ export const ops = {
   },
 
   // Generalized eigenbasis Wφ = λAφ of the mesh in `slot` (core/spectral/spectral_basis.h).
-  // options {slot?, k?, ncv?, relative_shift?, tolerance?, max_iterations?}
+  // options {slot?, k?, ncv?, relative_shift?, tolerance?, max_iterations?, solver?}
   // → buffers {eigenvalues: Float64Array k, vectors: Float32Array k·#W (function i at [i·#W, (i+1)·#W))}
-  //   info {slot, k, weldedVertices, iterations, operations, milliseconds}
+  //   info {slot, k, weldedVertices, iterations, operations, solver, milliseconds}
   eigs(ctx, options = {}) {
     const mesh = meshInSlot(ctx, options.slot);
     const started = Date.now();
@@ -118,6 +118,7 @@ export const ops = {
       relative_shift: options.relative_shift,
       tolerance: options.tolerance,
       max_iterations: options.max_iterations,
+      solver: options.solver,
     }, (stage, fraction) => ctx.progress(stage, fraction)));
     return {
       buffers: { eigenvalues: r.eigenvalues, vectors: r.vectors },
@@ -127,6 +128,7 @@ export const ops = {
         weldedVertices: mesh.weldedPositions.length / 3,
         iterations: r.iterations,
         operations: r.operations,
+        solver: r.solver,
         milliseconds: Date.now() - started,
       },
     };
