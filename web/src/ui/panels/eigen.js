@@ -1,7 +1,7 @@
 // The Eigenfunctions panel (part of the Mesh job): computes the generalized eigenbasis
 // Wφ = λAφ of the loaded mesh in the worker and colours the mesh by the i-th basis function.
 // Re-colouring on every slider move happens here (lib/colormap.js), without the worker.
-// State it owns (window.__meshmorph.state): eigen = {eigenvalues, vectors, k, milliseconds, i}
+// State it owns (window.__meshmorph.state): eigen = {eigenvalues, vectors, k, milliseconds, solver, i}
 // or null; reset when a new mesh loads.
 import { fieldColors } from '../../lib/colormap.js';
 import { finder, fromHtml } from '../dom.js';
@@ -59,7 +59,7 @@ export const panel = {
       viewer.setColors(fieldColors(e.vectors.subarray(e.i * n, (e.i + 1) * n), state.mesh.toWelded));
       $('eig-i').value = e.i;
       $('eig-i-out').textContent = `${e.i}`;
-      $('eig-value').textContent = `λ${subscript(e.i)} = ${e.eigenvalues[e.i].toPrecision(6)} (of ${e.k}; computed in ${e.milliseconds} ms)`;
+      $('eig-value').textContent = `λ${subscript(e.i)} = ${e.eigenvalues[e.i].toPrecision(6)} (of ${e.k}; computed in ${e.milliseconds} ms${e.solver ? `, ${e.solver}` : ''})`;
     }
 
     $('eig-run').addEventListener('click', async () => {
@@ -69,7 +69,7 @@ export const panel = {
       if (!result) return;
       state.eigen = {
         eigenvalues: result.buffers.eigenvalues, vectors: result.buffers.vectors, k: result.info.k,
-        milliseconds: result.info.milliseconds, i: 0,
+        milliseconds: result.info.milliseconds, solver: result.info.solver, i: 0,
       };
       $('eig-i').max = state.eigen.k - 1;
       $('eig-i').disabled = false;
