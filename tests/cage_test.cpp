@@ -39,6 +39,15 @@ struct Lcg {
 
 Mesh load(const std::string& rel) { return test::load_mesh(rel); }
 
+// n points spread inside the unit cube, 0.01 away from its faces (a fixed sequence).
+Eigen::MatrixXd points_in_unit_cube(int n) {
+  Lcg rng;
+  Eigen::MatrixXd P(n, 3);
+  for (int i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) P(i, c) = 0.01 + 0.98 * rng.next();
+  return P;
+}
+
 // Max over points of |Ψ C − P| and |Ψ 1 − 1|.
 void expect_reproduces(const Eigen::MatrixXd& Psi, const Eigen::MatrixXd& C, const Eigen::MatrixXd& P, double tol) {
   const double rep = (Psi * C - P).cwiseAbs().maxCoeff();
@@ -55,10 +64,7 @@ TEST(CageMvc, CubeInteriorPointsReproduced) {
   Eigen::MatrixXd C;
   Eigen::MatrixXi CF;
   cage_test::cube(&C, &CF);
-  cage_test::Lcg rng;
-  Eigen::MatrixXd P(200, 3);
-  for (int i = 0; i < P.rows(); ++i)
-    for (int c = 0; c < 3; ++c) P(i, c) = 0.01 + 0.98 * rng.next();
+  const Eigen::MatrixXd P = cage_test::points_in_unit_cube(200);
   MeanValueCoordinates m = mean_value_coordinates(P, C, CF);
   ASSERT_TRUE(m.status.ok()) << m.status.message;
   cage_test::expect_reproduces(m.Psi, C, P, 1e-12);
@@ -78,10 +84,7 @@ TEST(CageMvc, BlocksAcrossThreadsGiveTheSameRowsAndNameTheFailingPoint) {
   Eigen::MatrixXd C;
   Eigen::MatrixXi CF;
   cage_test::cube(&C, &CF);
-  cage_test::Lcg rng;
-  Eigen::MatrixXd P(5000, 3);
-  for (int i = 0; i < P.rows(); ++i)
-    for (int c = 0; c < 3; ++c) P(i, c) = 0.01 + 0.98 * rng.next();
+  Eigen::MatrixXd P = cage_test::points_in_unit_cube(5000);
   Eigen::MatrixXd Psi[3];
   const int counts[3] = {1, 2, 4};
   for (int t = 0; t < 3; ++t) {
