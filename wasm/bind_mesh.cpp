@@ -330,10 +330,7 @@ val spectral_basis_js(const val& positions, const val& indices, const val& optio
   opt.relative_shift = get_number(options, "relative_shift", opt.relative_shift);
   opt.tolerance = get_number(options, "tolerance", opt.tolerance);
   opt.max_iterations = get_int(options, "max_iterations", opt.max_iterations);
-  const std::string solver = get_string(options, "solver", "auto");
-  if (solver == "block") opt.solver = EigenSolverKind::BlockLanczos;
-  else if (solver == "spectra") opt.solver = EigenSolverKind::Spectra;
-  else if (solver != "auto")
+  if (!parse_eigen_solver(get_string(options, "solver", "auto"), &opt.solver))
     return status_object(Status::error(StatusCode::InvalidArgument, "solver must be 'auto', 'block' or 'spectra'"));
 
   const SpectralBasis basis = spectral_basis(V, F, opt, js_progress(progress));

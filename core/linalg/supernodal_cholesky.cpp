@@ -333,11 +333,10 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
       bin_of[x] = k;
       for (int t = first[x]; t <= x; ++t) bins[k].push_back(t);
     }
-    const auto load_bin_of = [&](int x) { return bin_of[x]; };
     for (int k = 0; k < 2; ++k) std::sort(bins[k].begin(), bins[k].end());
     top_ = top;
     first_ = first;
-    for (int x : open) bins_[load_bin_of(x)].push_back(x);
+    for (int x : open) bins_[bin_of[x]].push_back(x);
     for (int k = 0; k < 2; ++k) std::sort(bins_[k].begin(), bins_[k].end());
     std::atomic<bool> stop{false};
     Status worker_status = Status::success();

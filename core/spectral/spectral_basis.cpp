@@ -160,7 +160,6 @@ LanczosRun run_block(const SupernodalCholesky& chol, const Eigen::VectorXd& d, i
       bo);
   run.status = r.status;
   run.iterations = r.restarts;
-
   if (!r.status.ok()) return run;
   run.values = (sigma + r.values.array().inverse()).matrix();
   run.vectors = d.cwiseInverse().asDiagonal() * r.vectors;
@@ -182,6 +181,14 @@ LanczosRun run_dense(const Eigen::SparseMatrix<double>& W, const Eigen::VectorXd
 }
 
 }  // namespace
+
+bool parse_eigen_solver(const std::string& name, EigenSolverKind* kind) {
+  if (name == "auto") *kind = EigenSolverKind::Auto;
+  else if (name == "block") *kind = EigenSolverKind::BlockLanczos;
+  else if (name == "spectra") *kind = EigenSolverKind::Spectra;
+  else return false;
+  return true;
+}
 
 SpectralBasis spectral_basis(const Eigen::SparseMatrix<double>& W, const Eigen::VectorXd& mass,
                              const SpectralBasisOptions& opt, const Progress& progress) {

@@ -10,6 +10,8 @@
 //   degenerate eigenspace are not unique: compare eigenvalues and projections, not raw vectors.
 #pragma once
 
+#include <string>
+
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
@@ -26,6 +28,9 @@ namespace mm {
 // matrix–matrix products win despite needing ~1.5× the solves (docs/bench.md, thirteenth session:
 // k = 100 at 52k vertices 5.5 → 2.8 s; at 11k, a 18 MB basis, Spectra 0.45 s vs block 0.6 s).
 enum class EigenSolverKind { Auto, BlockLanczos, Spectra };
+
+// "auto" | "block" | "spectra" (the CLI's --solver, the wasm option); false for anything else.
+bool parse_eigen_solver(const std::string& name, EigenSolverKind* kind);
 
 struct SpectralBasisOptions {
   int k = 20;                 // number of eigenpairs; 1 ≤ k < #V

@@ -51,10 +51,7 @@ int run_eigs(const std::vector<std::string>& argv) {
   SpectralBasisOptions opt;
   opt.k = args.get_int("k", opt.k, &s);
   opt.tolerance = args.get_double("tolerance", opt.tolerance, &s);
-  const std::string solver = args.get("solver", "auto");
-  if (solver == "block") opt.solver = EigenSolverKind::BlockLanczos;
-  else if (solver == "spectra") opt.solver = EigenSolverKind::Spectra;
-  else if (solver != "auto") s = Status::error(StatusCode::InvalidArgument, "--solver must be auto, block or spectra");
+  if (!parse_eigen_solver(args.get("solver", "auto"), &opt.solver)) s = Status::error(StatusCode::InvalidArgument, "--solver must be auto, block or spectra");
   const int show = args.get_int("show", 1, &s);
   const std::string out = args.get("out");
   if (!s.ok()) return report("eigs", s);
