@@ -210,6 +210,14 @@ void check_similarity(const PrecisionCase& c, double soft_weight = 0) {
     const double fin2 = relative_error(ed.finalize(FeatureSize::Scale), expected, diag);
     report(tag + " drag_positions + finalize Eq. 10", fin2);
     EXPECT_LE(fin2, kTolerance) << tag;
+    // The interactive preview: one plain normal-equations solve, no refinement — off by
+    // ~eps·cond(A)², as an LᵀL drag would be; refining (above) removes it.
+    const EditResult q = ed.drag_positions(expected, 0);
+    EXPECT_EQ(q.refinements, 0) << tag;
+    const double prev = relative_error(q, expected, diag);
+    report(tag + " drag_positions preview (1 solve)", prev);
+    EXPECT_LE(prev, 1e-4) << tag;
+    EXPECT_GT(prev, pos) << tag << ": the refinement should have had something to remove";
   }
 }
 

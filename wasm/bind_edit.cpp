@@ -14,8 +14,10 @@
 //     Precomputes and factors both systems; returning false from progress cancels (Cancelled).
 //   s.drag(transforms: [TRANSFORM, ...] | JSON string, one per handle; TRANSFORM as in the spec
 //          or {matrix: [16 numbers, column-major]})          → {ok, positions: Float32Array (#V·3)}
-//   s.dragPositions(targets: Float64Array (#V·3); only handle rows are read)
+//   s.dragPositions(targets: Float64Array (#V·3); only handle rows are read, preview?: bool)
 //                                                            → {ok, positions: Float32Array}
+//     preview = true: one plain solve, no iterative refinement (the frames of a pointer drag;
+//     LaplacianEditor::drag_positions).
 //   s.finalize(mode?: "keep" | "scale" (default: the spec's "features"))
 //                                                            → {ok, positions: Float32Array}
 //   s.dispose()  frees the editor's memory (the JS wrapper then calls s.delete()).
@@ -109,8 +111,9 @@ class EditSession {
     return edit_positions(editor_.drag(t.transforms));
   }
 
-  val dragPositions(const val& targets) {
-    return edit_positions(editor_.drag_positions(to_matrix(targets)));
+  val dragPositions(const val& targets, const val& preview) {
+    const bool quick = preview.isTrue();
+    return edit_positions(editor_.drag_positions(to_matrix(targets), quick ? 0 : -1));
   }
 
   val finalize(const val& mode) {

@@ -48,10 +48,12 @@ Status LaplacianEditor::Impl::build_handle_basis(EditBuild& s, const Progress& p
     }
   if (!progress.update("edit: handle basis", 0.9)) return cancelled_status("edit: handle basis");
   Eigen::MatrixXd X = Eigen::MatrixXd::Zero(nU, m);
+  bool from_zero = true;  // refine_solution starts from X = 0
   const IterativeRefinementReport rep = refine_solution(
       [&](const Eigen::MatrixXd& xx, Eigen::MatrixXd* g) {
         Y.topRows(nU) = xx;
-        stage1_normal_residual(Y, grad_rhs, soft_target, g);
+        stage1_normal_residual(Y, grad_rhs, soft_target, g, from_zero);
+        from_zero = false;
       },
       [&](Eigen::MatrixXd* r) { solver1.solve_in_place(*r); }, &X, opt.residual_refinements);
   if (!rep.status.ok()) return rep.status;

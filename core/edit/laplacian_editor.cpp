@@ -189,7 +189,7 @@ EditResult LaplacianEditor::drag(const std::vector<HandleTransform>& transforms)
   return m.output_stage1(refinements);
 }
 
-EditResult LaplacianEditor::drag_positions(const Eigen::MatrixXd& targets) {
+EditResult LaplacianEditor::drag_positions(const Eigen::MatrixXd& targets, int max_refinements) {
   Impl& m = *impl_;
   if (!m.ready) return edit_error(StatusCode::InvalidArgument, "drag_positions called before a successful precompute");
   if (targets.rows() != m.V.rows() || targets.cols() != 3)
@@ -249,7 +249,7 @@ EditResult LaplacianEditor::drag_positions(const Eigen::MatrixXd& targets) {
     return m.solve_stage2(false, FeatureSize::Keep);
   }
   int refinements = 0;
-  if (Status s = m.solve_stage1(known_u, soft_ud, linear, nullptr, &refinements); !s.ok()) {
+  if (Status s = m.solve_stage1(known_u, soft_ud, linear, nullptr, &refinements, max_refinements); !s.ok()) {
     EditResult r;
     r.status = s;
     return r;

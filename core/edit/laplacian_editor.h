@@ -200,7 +200,12 @@ class LaplacianEditor {
   // Stage 1 for arbitrary targets: rows of `targets` (#V by 3) at handle vertices are read,
   // others ignored. Three back-substitutions. With gradient constraints, each handle's linear
   // part is the best-fit similarity of its rest → target positions.
-  EditResult drag_positions(const Eigen::MatrixXd& targets);
+  // max_refinements: refinement steps for this call (-1 = options().residual_refinements). 0 is
+  // the interactive preview — one plain normal-equations solve, like an LᵀL drag, off by
+  // ~eps·cond(A)² (measured: 8e-9–5e-7 of the diagonal in tests/edit_precision_test.cpp, at most
+  // 6.7e-5 on michael3's bench drag) — for the frames of a pointer drag; refine on release
+  // (merge always refines).
+  EditResult drag_positions(const Eigen::MatrixXd& targets, int max_refinements = -1);
   // Stage 2 after a drag: shear removal (Sec. 4) and Eq. 9 (Keep) / Eq. 10 (Scale).
   EditResult finalize(FeatureSize mode = FeatureSize::Keep);
 

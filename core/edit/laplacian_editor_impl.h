@@ -138,12 +138,21 @@ struct LaplacianEditor::Impl {
   // gradient-constraint rows per stencil direction c (empty without gradient constraints);
   // soft_target: nU by m (rows with soft > 0 read; empty without soft constraints). nU by m.
   void stage1_normal_residual(const Eigen::MatrixXd& Y, const std::vector<Eigen::MatrixXd>& grad_rhs,
-                              const Eigen::MatrixXd& soft_target, Eigen::MatrixXd* g) const;
+                              const Eigen::MatrixXd& soft_target, Eigen::MatrixXd* g,
+                              bool unknowns_zero = false);
+  // Sparsity of a residual from x = 0 (stage1_normal_residual's unknowns_zero; built on first use).
+  struct ZeroStartLists {
+    bool ready = false;
+    std::vector<int> first, second;   // pairs (see residual_pairs)
+    std::vector<int> rows;            // E_L rows that read a constrained vertex
+    edit_detail::EditSparse E1U;      // those rows, unknowns' columns
+  } zero_start;
+  void build_zero_start_lists();
   // Stage 1 for known displacements u_K (nK by 3, displaced frame), soft target displacements
   // (nU by 3 or empty) and the handles' linear parts; with `translation`, by the handle basis.
   Status solve_stage1(const Eigen::MatrixXd& known_u, const Eigen::MatrixXd& soft_u_d,
                       const std::vector<Eigen::Matrix3d>& linear, const std::vector<Eigen::Vector3d>* translation,
-                      int* refinements);
+                      int* refinements, int max_refinements = -1);
   EditResult output_stage1(int refinements);
   EditResult solve_stage2(bool use_rotations, FeatureSize mode);
   Eigen::Matrix3d gradient_local(int l) const;  // M of unknown l from U1 (I + Σ u_k w_kᵀ)

@@ -325,10 +325,15 @@ struct ResidualPairs {
   const std::vector<Eigen::MatrixXd>* grad_rhs;
 };
 
+// first/second (optional, ascending): the pairs whose m_p can be nonzero and those whose Z_p or
+// gradient-constraint rows can be — all pairs when null (see ZeroStartLists).
 template <int M>
-void residual_pairs(const ResidualPairs& a, const double* Y, double* Mg, double* G) {
+void residual_pairs(const ResidualPairs& a, const double* Y, double* Mg, double* G,
+                    const std::vector<int>* first = nullptr, const std::vector<int>* second = nullptr) {
   const int m = M > 0 ? M : a.m;
-  for (int p = 0; p < a.nP; ++p) {
+  const int n1 = first ? static_cast<int>(first->size()) : a.nP;
+  for (int i1 = 0; i1 < n1; ++i1) {
+    const int p = first ? (*first)[static_cast<size_t>(i1)] : i1;
     const int c = a.pair_center[p];
     double* M0 = Mg + 3 * static_cast<long>(p) * m;
     double *M1 = M0 + m, *M2 = M1 + m;
@@ -344,7 +349,9 @@ void residual_pairs(const ResidualPairs& a, const double* Y, double* Mg, double*
   }
   std::vector<double> Zbuf(3 * static_cast<size_t>(m));
   double* Z = Zbuf.data();
-  for (int p = 0; p < a.nP; ++p) {
+  const int n2 = second ? static_cast<int>(second->size()) : a.nP;
+  for (int i2 = 0; i2 < n2; ++i2) {
+    const int p = second ? (*second)[static_cast<size_t>(i2)] : i2;
     if (!a.pair_active[p]) continue;  // its stencil has no unknown: no column of A_U to feed
     const double* Mp = Mg + 3 * static_cast<long>(p) * m;
     const int deg = a.partner_ptr[p + 1] - a.partner_ptr[p];
@@ -373,23 +380,74 @@ void residual_pairs(const ResidualPairs& a, const double* Y, double* Mg, double*
 
 }  // namespace
 
+void LaplacianEditor::Impl::build_zero_start_lists() {
+  // Pairs whose gradient reads a constrained vertex (m_p ≠ 0 when only those move) ...
+  const int nP = static_cast<int>(pair_center.size());
+  std::vector<char> in1(static_cast<size_t>(nP), 0);
+  zero_start.first.clear();
+  zero_start.second.clear();
+  for (int p = 0; p < nP; ++p) {
+    const int c = pair_center[p];
+    for (int e = grads.offsets[c]; e < grads.offsets[c + 1] && !in1[static_cast<size_t>(p)]; ++e)
+      if (stencil_local[e] >= nU) in1[static_cast<size_t>(p)] = 1;
+    if (in1[static_cast<size_t>(p)]) zero_start.first.push_back(p);
+  }
+  // ... and those whose E_R difference or gradient-constraint rows can then be nonzero.
+  for (int p = 0; p < nP; ++p) {
+    bool any = in1[static_cast<size_t>(p)] || (opt.gradient_constraint_weight > 0 && pair_handle[p] >= 0);
+    for (int q = partner_ptr[p]; q < partner_ptr[p + 1] && !any; ++q) any = in1[static_cast<size_t>(partners[q])];
+    if (any) zero_start.second.push_back(p);
+  }
+  // E_L rows that read a constrained vertex, restricted to the unknowns' columns (transposed).
+  const edit_detail::EditSparse EK = E1.rightCols(E1.cols() - nU);
+  std::vector<char> row_in(static_cast<size_t>(E1.rows()), 0);
+  for (int k = 0; k < EK.outerSize(); ++k)
+    for (edit_detail::EditSparse::InnerIterator it(EK, k); it; ++it) row_in[static_cast<size_t>(it.row())] = 1;
+  zero_start.rows.clear();
+  std::vector<int> slot(static_cast<size_t>(E1.rows()), -1);
+  for (size_t r = 0; r < row_in.size(); ++r)
+    if (row_in[r]) slot[r] = static_cast<int>(zero_start.rows.size()), zero_start.rows.push_back(static_cast<int>(r));
+  std::vector<Eigen::Triplet<double>> t;
+  for (int j = 0; j < nU; ++j)
+    for (edit_detail::EditSparse::InnerIterator it(E1, j); it; ++it)
+      if (slot[static_cast<size_t>(it.row())] >= 0) t.emplace_back(slot[static_cast<size_t>(it.row())], j, it.value());
+  zero_start.E1U.resize(static_cast<Eigen::Index>(zero_start.rows.size()), nU);
+  zero_start.E1U.setFromTriplets(t.begin(), t.end());
+  zero_start.ready = true;
+}
+
 void LaplacianEditor::Impl::stage1_normal_residual(const Eigen::MatrixXd& Y, const std::vector<Eigen::MatrixXd>& grad_rhs,
-                                                   const Eigen::MatrixXd& soft_target, Eigen::MatrixXd* g) const {
+                                                   const Eigen::MatrixXd& soft_target, Eigen::MatrixXd* g,
+                                                   bool unknowns_zero) {
   using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   const int m = static_cast<int>(Y.cols());
   const int nP = static_cast<int>(pair_center.size());
-  const Eigen::MatrixXd EY = E1 * Y;
-  RowMat G = -(E1.transpose() * EY).topRows(nU);
+  RowMat G;
+  if (unknowns_zero) {
+    // The first residual of a solve from x = 0 (a drag's right-hand side): only the constrained
+    // rows of Y move, so only the E_L rows and pairs near them contribute — the terms left out
+    // are exact zeros. Costs ~the constrained region instead of the whole mesh.
+    if (!zero_start.ready) build_zero_start_lists();
+    const Eigen::MatrixXd EY = E1.rightCols(E1.cols() - nU) * Y.bottomRows(Y.rows() - nU);
+    Eigen::MatrixXd EYr(static_cast<Eigen::Index>(zero_start.rows.size()), m);
+    for (size_t r = 0; r < zero_start.rows.size(); ++r) EYr.row(static_cast<Eigen::Index>(r)) = EY.row(zero_start.rows[r]);
+    G = -(zero_start.E1U.transpose() * EYr);
+  } else {
+    const Eigen::MatrixXd EY = E1 * Y;
+    G = -(E1.transpose() * EY).topRows(nU);
+  }
   const RowMat Yr = Y;
   RowMat Mg = RowMat::Zero(3 * static_cast<Eigen::Index>(nP), m);
   const ResidualPairs a{nP, nU, m, pair_center.data(), grads.offsets.data(), stencil_local.data(), partner_ptr.data(),
                         partners.data(), pair_handle.data(), pair_active.data(), grads.weights.data(),
                         static_cast<long>(grads.weights.rows()), opt.coherence_weight, opt.gradient_constraint_weight,
                         &grad_rhs};
-  if (m == 3) residual_pairs<3>(a, Yr.data(), Mg.data(), G.data());
-  else if (m == 4) residual_pairs<4>(a, Yr.data(), Mg.data(), G.data());
-  else if (m == 8) residual_pairs<8>(a, Yr.data(), Mg.data(), G.data());
-  else residual_pairs<0>(a, Yr.data(), Mg.data(), G.data());
+  const std::vector<int>* l1 = unknowns_zero ? &zero_start.first : nullptr;
+  const std::vector<int>* l2 = unknowns_zero ? &zero_start.second : nullptr;
+  if (m == 3) residual_pairs<3>(a, Yr.data(), Mg.data(), G.data(), l1, l2);
+  else if (m == 4) residual_pairs<4>(a, Yr.data(), Mg.data(), G.data(), l1, l2);
+  else if (m == 8) residual_pairs<8>(a, Yr.data(), Mg.data(), G.data(), l1, l2);
+  else residual_pairs<0>(a, Yr.data(), Mg.data(), G.data(), l1, l2);
   if (soft_target.size())
     for (int l = 0; l < nU; ++l)
       if (soft[l] > 0) G.row(l) += soft[l] * (soft_target.row(l) - Y.row(l));
@@ -398,7 +456,8 @@ void LaplacianEditor::Impl::stage1_normal_residual(const Eigen::MatrixXd& Y, con
 
 Status LaplacianEditor::Impl::solve_stage1(const Eigen::MatrixXd& known_u, const Eigen::MatrixXd& soft_u_d,
                                            const std::vector<Eigen::Matrix3d>& linear_parts,
-                                           const std::vector<Eigen::Vector3d>* translation, int* refinements) {
+                                           const std::vector<Eigen::Vector3d>* translation, int* refinements,
+                                           int max_refinements) {
   linear = linear_parts;
   *refinements = 0;
   U1.resize(nL, 3);
@@ -422,12 +481,15 @@ Status LaplacianEditor::Impl::solve_stage1(const Eigen::MatrixXd& known_u, const
   if (opt.gradient_constraint_weight > 0)
     for (int h = 0; h < num_handles; ++h) grad_rhs.push_back((linear_parts[h] - Eigen::Matrix3d::Identity()).transpose());
   Eigen::MatrixXd Y = U1, x = Eigen::MatrixXd::Zero(nU, 3);
+  bool from_zero = true;  // refine_solution starts from x = 0
   const IterativeRefinementReport rep = refine_solution(
       [&](const Eigen::MatrixXd& xx, Eigen::MatrixXd* g) {
         Y.topRows(nU) = xx;
-        stage1_normal_residual(Y, grad_rhs, soft_u_d, g);
+        stage1_normal_residual(Y, grad_rhs, soft_u_d, g, from_zero);
+        from_zero = false;
       },
-      [&](Eigen::MatrixXd* r) { solver1.solve_in_place(*r); }, &x, opt.residual_refinements);
+      [&](Eigen::MatrixXd* r) { solver1.solve_in_place(*r); }, &x,
+      max_refinements >= 0 ? max_refinements : opt.residual_refinements);
   if (!rep.status.ok()) return rep.status;
   U1.topRows(nU) = x;
   *refinements = rep.steps;

@@ -99,13 +99,14 @@ export const ops = {
     return positionsResult(ctx, entry, entry.session.drag(options.transforms), started);
   },
 
-  // options {slot?}, buffers {targets: Float64Array #W·3 (only handle rows are read)}
+  // options {slot?, preview?: true — one plain solve for the frames of a pointer drag, refine on
+  // release}, buffers {targets: Float64Array #W·3 (only handle rows are read)}
   // → buffers {positions, rawPositions}
   editDragPositions(ctx, options = {}, buffers = {}) {
     const entry = sessionFor(ctx, options.slot || defaultSlot);
     if (!buffers.targets) throw new MeshMorphError('InvalidArgument', 'editDragPositions needs buffers.targets');
     const started = Date.now();
-    return positionsResult(ctx, entry, entry.session.dragPositions(buffers.targets), started);
+    return positionsResult(ctx, entry, entry.session.dragPositions(buffers.targets, options.preview === true), started);
   },
 
   // options {slot?, mode?: 'keep' | 'scale'} — shear removal and the second solve after a drag.
