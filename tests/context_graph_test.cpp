@@ -161,7 +161,7 @@ namespace {
 // CesiumMan at time ta (template: vertices + mesh edges) onto its own surface at time tb (-1:
 // rest), joints as landmarks. Returns the fraction of 260 FPS "nodes" whose correspondence (the
 // closest target point of the deformed node) lies within 2% of the height of the true point.
-double icp_identity_fraction(double ta, double tb, bool* converged) {
+double icp_identity_fraction(double ta, double tb, bool articulated, bool* converged) {
   mm::io::LoadResult src = mm::io::load_asset(mm::test::data_path("anim/CesiumMan/CesiumMan.glb"));
   EXPECT_TRUE(src.status.ok());
   mm::io::CharacterResult cr = mm::io::animated_character(src.asset);
@@ -187,7 +187,12 @@ double icp_identity_fraction(double ta, double tb, bool* converged) {
   const auto t0 = std::chrono::steady_clock::now();
   mm::NonrigidIcpOptions o;
   o.tolerance = 1e-4 * h;
-  const mm::NonrigidIcpResult r = mm::nonrigid_icp(V0, mm::triangle_edges(c.F), target, lv, J0, J1, o);
+  std::vector<std::pair<int, int>> bones;
+  for (int i = 0; i < J.size(); ++i)
+    if (J.parent[i] >= 0) bones.push_back({i, J.parent[i]});
+  const Eigen::MatrixXd P = articulated ? mm::articulated_points(V0, J0, J1, bones) : V0;
+  const Eigen::MatrixXd L = articulated ? mm::articulated_points(J0, J0, J1, bones) : J0;
+  const mm::NonrigidIcpResult r = mm::nonrigid_icp(P, mm::triangle_edges(c.F), target, lv, L, J1, o);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_TRUE(r.status.ok()) << r.status.message;
   const std::vector<int> nodes = mm::farthest_point_sampling(V0, 260);
@@ -199,7 +204,7 @@ double icp_identity_fraction(double ta, double tb, bool* converged) {
     if (e < 0.02) ++good;
   }
   const double frac = double(good) / nodes.size();
-  std::cout << "[ NICP CesiumMan t=" << ta << " -> t=" << tb << " ] " << V0.rows() << " vertices, " << r.solves
+  std::cout << "[ NICP CesiumMan t=" << ta << " -> t=" << tb << (articulated ? ", bone start" : "") << " ] " << V0.rows() << " vertices, " << r.solves
             << " solves, " << ms << " ms; within 2% of height: " << frac << ", mean " << sum / nodes.size()
             << "; residual " << r.mean_residual << " converged " << r.converged << "\n";
   *converged = r.converged;
@@ -209,17 +214,23 @@ double icp_identity_fraction(double ta, double tb, bool* converged) {
 }  // namespace
 
 TEST(ContextNonrigidIcp, SameCharacterTwoPosesRecoversIdentity) {
-  // Two frames of the walk 0.2 s apart. The issue asks >= 90% of the nodes within 2% of the
-  // height: measured 0.892 (mean error 1.0% of the height), NOT met; guard the measurement.
+  // The issue asks >= 90% of the nodes within 2% of the height. Measured (fifteenth session),
+  // fraction / mean error of the height:
+  //                                      identity start   bone start (the retargeter's)
+  //   walk frame 0.3 s -> 0.5 s          0.892 / 1.05%    0.927 / 0.86%
+  //   rest pose -> walk frame 0.5 s      0.600 / 2.2%     0.950 / 0.86%
+  // From the identity the stiff first steps pull a swung arm onto the closest surface (the body)
+  // and never let go; the bones' rotations start each limb in its place.
   bool conv = false;
-  const double near = icp_identity_fraction(0.3, 0.5, &conv);
+  const double near = icp_identity_fraction(0.3, 0.5, true, &conv);
   EXPECT_TRUE(conv);
-  EXPECT_GE(near, 0.85);
-  // Rest pose → a walk frame (what the retargeting asks of it, large limb rotations): measured
-  // 0.60 (mean error 2.2% of the height; surface points slide along the limbs). The issue's 90%
-  // is NOT met here; guard what we measured.
-  const double far = icp_identity_fraction(-1, 0.5, &conv);
-  EXPECT_GE(far, 0.5);
+  EXPECT_GE(near, 0.9);
+  const double far = icp_identity_fraction(-1, 0.5, true, &conv);
+  EXPECT_TRUE(conv);
+  EXPECT_GE(far, 0.9);
+  // The plain Amberg start, for the record: clearly worse on the large pose change.
+  const double far_identity = icp_identity_fraction(-1, 0.5, false, &conv);
+  EXPECT_LT(far_identity, far - 0.2);
 }
 
 // ----------------------------------------------------------------------------- real retargeting
@@ -306,12 +317,17 @@ TEST(ContextGraphReal, ContactsKnightToBarbarian) {
     std::cout << "[ contacts " << clip << " ] pairs " << a.pairs << ": kept with graph " << a.fraction() << ", without "
               << b.fraction() << ", LBS " << c.fraction() << "\n";
     ASSERT_GT(a.pairs, 10);
-    EXPECT_GT(a.fraction(), b.fraction() + 0.3) << clip;  // measured 1.0 vs 0.36, 0.41 vs 0
     if (std::string(clip) == "Lie_Idle") {
+      // Measured 1.0 with the graph, 1.0 without, 1.0 LBS. (Until the fifteenth session the ICP
+      // started from the identity and put some hand nodes on the body: "without" read 0.36 then —
+      // the compatible nodes were wrong, not the retargeting.)
       EXPECT_GE(a.fraction(), 0.8);
-      EXPECT_GE(a.fraction(), c.fraction());  // a tie at 1.0
+      EXPECT_GE(a.fraction(), b.fraction());
+      EXPECT_GE(a.fraction(), c.fraction());
     } else {
-      // Sit_Floor_Idle: 0.41 measured, the issue's 0.8 and "better than LBS" (1.0) NOT met.
+      // Sit_Floor_Idle: measured 0.41 with the graph, 0 without; the issue's 0.8 and "better
+      // than LBS" (1.0) NOT met.
+      EXPECT_GT(a.fraction(), b.fraction() + 0.3);
       EXPECT_GE(a.fraction(), 0.3);
     }
     const Eigen::MatrixXi& F = on->session.target_faces();
@@ -420,6 +436,6 @@ TEST(ContextGraphReal, AccuracyWithAndWithoutTheGraph) {
               << " max " << be.max << " (precompute " << j->prepare_ms << " ms)\n";
     for (const auto& w : j->session.warnings())
       if (w.find("context graph") != std::string::npos) std::cout << "[ warning ] " << w << "\n";
-    EXPECT_LT(be.mean, 0.05);  // measured 0.029 without, 0.037 with the graph
+    EXPECT_LT(be.mean, 0.05);  // measured 0.029 without, 0.034 with the graph (0.037 before the ICP's bone start)
   }
 }

@@ -91,6 +91,7 @@ struct HarmonicRetargetOptions {
   double w_volume = 1.0;        // λ_volume (Sec. 7.2 list: 1)
   int icp_points = 800;         // non-rigid ICP template: the graph nodes plus FPS source vertices up to this
   int icp_neighbours = 6;       // k of the template's k-nearest-neighbour stiffness graph
+  bool icp_bone_start = true;   // start the ICP template posed by the bones (articulated_points)
   NonrigidIcpOptions icp;       // Amberg et al. 2007 schedule and convergence criteria
   int volume_surface_points = 300;  // target surface nodes of the volume graph (FPS collocation prefix)
   int volume_bone_samples = 3;      // interior nodes per bone besides its ends

@@ -120,7 +120,12 @@ Status HarmonicRetargeter::build_context_graph(const Eigen::MatrixXd& Xs, const 
     for (size_t i = 0; i < fps.size(); ++i) T.row(N + i) = Xs.row(fps[i]);
     const int m = static_cast<int>(Js_rest_.rows());
     Eigen::VectorXi lv = nearest_centers(Js_rest_, T);
-    NonrigidIcpResult icp = nonrigid_icp(T, knn_edges(T, opt.icp_neighbours), bvh_t, lv, Js_rest_, Jt_rest_, opt.icp);
+    // The template starts posed by the bones (source joints → target joints), the stiffness
+    // graph is the rest template's: the ICP then only closes the shape difference.
+    const bool posed = opt.icp_bone_start && !bones_.empty();
+    const Eigen::MatrixXd Tp = posed ? articulated_points(T, Js_rest_, Jt_rest_, bones_) : T;
+    const Eigen::MatrixXd Jp = posed ? articulated_points(Js_rest_, Js_rest_, Jt_rest_, bones_) : Js_rest_;
+    NonrigidIcpResult icp = nonrigid_icp(Tp, knn_edges(T, opt.icp_neighbours), bvh_t, lv, Jp, Jt_rest_, opt.icp);
     if (!icp.status.ok()) return Status{icp.status.code, "context graph: " + icp.status.message};
     graph_.icp_converged = icp.converged;
     graph_.icp_residual = icp.mean_residual;
