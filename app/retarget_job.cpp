@@ -44,6 +44,10 @@ const OptionSchema<RetargetJobOptions>& retarget_options() {
               "target surface points with affine descriptors (0 = joints only)");
     s.text("anchor_joint", [](O& o) -> std::string& { return o.harmonic.anchor_joint; },
            "joint whose (scaled) trajectory the target follows (\"\" = the shallowest)");
+    s.choice<bool>("articulated_base", [](O& o) -> bool& { return o.harmonic.articulated_base; },
+                   {{"on", true}, {"off", false}},
+                   "bones' motions learned from the clip carry the surfaces; the harmonic maps add the rest "
+                   "(off: the paper's maps alone; off while the context graph is on)");
     s.choice<bool>("context_graph", [](O& o) -> bool& { return o.harmonic.context_graph; },
                    {{"on", true}, {"off", false}},
                    "context graph terms E_spatial and E_volume (Sec. 6, Eq. 11-12)");
@@ -152,6 +156,27 @@ Status RetargetJob::prepare(const io::Asset& source, const io::Asset& target, co
       for (int i = 0; i < k; ++i) gf.push_back(source_frame(k > 1 ? i * (nf - 1) / (k - 1) : 0));
     }
     harmonic_.set_graph_frames(std::move(gf));
+    // The articulated base learns the source's bone weights from poses spread evenly over all of
+    // its clips end to end (not only the chosen one): the weights, and so every clip's result,
+    // do not depend on which clip was prepared (the batch worker reuses one preparation).
+    std::vector<Eigen::MatrixXd> bf;
+    if (opt.harmonic.articulated_base && opt.harmonic.base_frames > 0 && !source_.clips.empty()) {
+      double total = 0;
+      for (const AnimationClip& c : source_.clips) total += std::max(0.0, c.end - c.start);
+      const int k = opt.harmonic.base_frames;
+      for (int i = 0; i < k; ++i) {
+        double at = (i + 0.5) * total / k;
+        for (size_t c = 0; c < source_.clips.size(); ++c) {
+          const double len = std::max(0.0, source_.clips[c].end - source_.clips[c].start);
+          if (at <= len || c + 1 == source_.clips.size()) {
+            bf.push_back(pose_at(source_, static_cast<int>(c), source_.clips[c].start + std::min(at, len)));
+            break;
+          }
+          at -= len;
+        }
+      }
+    }
+    harmonic_.set_base_frames(std::move(bf));
     s = harmonic_.precompute(S, T, map, opt.harmonic, target_joints_json == "auto" ? progress.sub(0.3, 1) : progress);
     if (!s.ok()) return s;
     for (auto& w : harmonic_.warnings()) warnings_.push_back(w);

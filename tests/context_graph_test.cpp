@@ -18,6 +18,7 @@
 #include "io/asset.h"
 #include "mesh/mesh.h"
 #include "metrics/retarget_metrics.h"
+#include "retarget/bone_blend.h"
 #include "retarget/context_graph.h"
 #include "retarget/nonrigid_icp.h"
 #include "spatial/farthest_point_sampling.h"
@@ -58,6 +59,8 @@ std::unique_ptr<GJob> gjob(const std::string& src, const std::string& tgt, const
   o.last_frame = last;
   o.method = method;
   o.harmonic.context_graph = graph;
+  // The graph's comparisons are against the paper's maps alone (the base is off with the graph).
+  o.harmonic.articulated_base = false;
   if (tweak) tweak(o);
   const auto t0 = std::chrono::steady_clock::now();
   j->status = j->session.prepare(j->src.asset, j->tgt.asset, joints, "", o);
@@ -217,8 +220,8 @@ TEST(ContextNonrigidIcp, SameCharacterTwoPosesRecoversIdentity) {
   // The issue asks >= 90% of the nodes within 2% of the height. Measured (fifteenth session),
   // fraction / mean error of the height:
   //                                      identity start   bone start (the retargeter's)
-  //   walk frame 0.3 s -> 0.5 s          0.892 / 1.05%    0.927 / 0.86%
-  //   rest pose -> walk frame 0.5 s      0.600 / 2.2%     0.950 / 0.86%
+  //   walk frame 0.3 s -> 0.5 s          0.892 / 1.05%    0.923 / 0.95%
+  //   rest pose -> walk frame 0.5 s      0.600 / 2.2%     0.946 / 0.94%
   // From the identity the stiff first steps pull a swung arm onto the closest surface (the body)
   // and never let go; the bones' rotations start each limb in its place.
   bool conv = false;

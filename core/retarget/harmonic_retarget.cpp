@@ -237,6 +237,96 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
     s = build_context_graph(Xs, source.F, Xt, target.F, bvh_s, bvh_t, opt);
     if (!s.ok()) return s;
   }
+  base_on_ = opt.articulated_base && !bones_.empty() && !opt.context_graph;
+  if (opt.articulated_base && opt.context_graph)
+    warnings_.push_back("articulated base off: it is not combined with the context graph yet (the paper's maps alone)");
+  if (base_on_) {
+    Xs_rest_ = Xs;
+    Xt_rest_ = Xt;
+    const int nb = static_cast<int>(bones_.size());
+    BoneBlend bv = bone_blend(Xs, Js_rest_, bones_);
+    // Each bone's rigid fit: the source vertices it moves with at least base_fit_weight, weighed
+    // by that weight squared (a bone with fewer than 6 takes every vertex it has a share of).
+    auto fit_sets = [&](const BoneBlend& w) {
+      base_fit_set_.assign(nb, {});
+      base_fit_w_.assign(nb, {});
+      std::vector<std::vector<int>> loose(nb);
+      std::vector<std::vector<double>> loose_w(nb);
+      for (int i = 0; i < w.rows(); ++i)
+        for (int k = w.ptr[i]; k < w.ptr[i + 1]; ++k) {
+          const int b = w.bone[k];
+          const bool firm = w.w[k] >= opt.base_fit_weight;
+          (firm ? base_fit_set_[b] : loose[b]).push_back(i);
+          (firm ? base_fit_w_[b] : loose_w[b]).push_back(w.w[k] * w.w[k]);
+        }
+      for (int b = 0; b < nb; ++b)
+        if (base_fit_set_[b].size() < 6) {
+          base_fit_set_[b].insert(base_fit_set_[b].end(), loose[b].begin(), loose[b].end());
+          base_fit_w_[b].insert(base_fit_w_[b].end(), loose_w[b].begin(), loose_w[b].end());
+        }
+    };
+    fit_sets(bv);
+    // Weights learned from the clip (surface only: which bones' motions explain each source
+    // vertex over the sample frames), carried to the target through bone coordinates.
+    std::vector<Eigen::MatrixXd> samples;
+    for (const Eigen::MatrixXd& Vf : base_frames_)
+      if (Vf.rows() == Xs.rows() && Vf.cols() == 3 && Vf.allFinite())
+        samples.push_back(to_working(Vf, cs_, Ls_, Eigen::Matrix3d::Identity()));
+    bool learned = false;
+    if (!samples.empty()) {
+      std::vector<BoneMotions> motions;
+      for (const Eigen::MatrixXd& Xf : samples) {
+        Eigen::MatrixXd Jb;
+        std::vector<Eigen::Matrix3d> Rf;
+        motions.push_back(source_base(Xf, &Jb, &Rf));
+      }
+      const BoneBlend candidates = bone_blend(Xs, Js_rest_, bones_, 3.0);
+      bv = learn_bone_weights(Xs, samples, motions, candidates);
+      fit_sets(bv);
+      learned = true;
+    }
+    colloc_rest_s_ = src_map_.collocation_positions(Xs);
+    if (learned) {
+      const SurfaceSamples& C = src_map_.collocation();
+      blend_colloc_s_ = interpolate_blend(bv, source.F, C.face, C.barycentric);
+      const BoneCorrespondence bc = bone_correspondence(Xt, bones_, Jt_rest_, Js_rest_, bvh_t, bvh_s);
+      const BoneBlend fallback = bone_blend(Xt, Jt_rest_, bones_);
+      Eigen::VectorXi face(Xt.rows());
+      Eigen::MatrixXd bary(Xt.rows(), 3);
+      for (Eigen::Index i = 0; i < Xt.rows(); ++i) {
+        const ClosestPoint cp = bvh_s.closest_point(bc.X.row(i).transpose());
+        face[i] = bc.bone[i] >= 0 ? cp.face : -1;
+        bary.row(i) = cp.barycentric.transpose();
+      }
+      blend_verts_t_ = interpolate_blend(bv, source.F, face, bary, &fallback);
+    } else {
+      blend_colloc_s_ = bone_blend(colloc_rest_s_, Js_rest_, bones_);
+      blend_verts_t_ = bone_blend(Xt, Jt_rest_, bones_);
+    }
+    // Forward-kinematics order: from each root down (bones_ are (child, parent) joint pairs).
+    std::vector<std::vector<int>> child_bones(m);
+    std::vector<char> is_child(m, 0);
+    for (int b = 0; b < nb; ++b) {
+      child_bones[bones_[b].second].push_back(b);
+      is_child[bones_[b].first] = 1;
+    }
+    fk_bones_.clear();
+    joint_root_.assign(m, -1);
+    for (int r = 0; r < m; ++r) {
+      if (is_child[r]) continue;
+      joint_root_[r] = r;
+      std::vector<int> stack{r};
+      while (!stack.empty()) {
+        const int j = stack.back();
+        stack.pop_back();
+        for (int b : child_bones[j]) {
+          fk_bones_.push_back(b);
+          joint_root_[bones_[b].first] = r;
+          stack.push_back(bones_[b].first);
+        }
+      }
+    }
+  }
   s = synth_.factor(opt.ridge);
   if (!s.ok()) return s;
   // Per-frame operators. Everything but the bone directions is linear in the projection
@@ -278,6 +368,84 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
   return Status::success();
 }
 
+BoneMotions HarmonicRetargeter::source_bone_motions(const Eigen::MatrixXd& Xs) const {
+  const int nb = static_cast<int>(bones_.size());
+  BoneMotions M;
+  M.R.assign(nb, Eigen::Matrix3d::Identity());
+  M.t = Eigen::MatrixXd::Zero(nb, 3);
+  std::vector<char> fitted(nb, 0);
+  for (int b = 0; b < nb; ++b) {
+    const std::vector<int>& set = base_fit_set_[b];
+    if (set.size() < 4) continue;
+    Eigen::MatrixXd P(set.size(), 3), Q(set.size(), 3);
+    Eigen::VectorXd w(set.size());
+    for (size_t k = 0; k < set.size(); ++k) {
+      P.row(k) = Xs_rest_.row(set[k]);
+      Q.row(k) = Xs.row(set[k]);
+      w[k] = base_fit_w_[b][k];
+    }
+    const RigidFit f = fit_rigid(P, Q, w);
+    if (f.degenerate) continue;
+    M.R[b] = f.R;
+    M.t.row(b) = f.t.transpose();
+    fitted[b] = 1;
+  }
+  // Bones without a fit (too few or collinear vertices): the motion of the parent's bone.
+  for (int b : fk_bones_) {
+    if (fitted[b]) continue;
+    for (int a : fk_bones_)
+      if (bones_[a].first == bones_[b].second && fitted[a]) {
+        M.R[b] = M.R[a];
+        M.t.row(b) = M.t.row(a);
+        fitted[b] = 1;
+        break;
+      }
+  }
+  return M;
+}
+
+BoneMotions HarmonicRetargeter::forward_kinematics(const std::vector<Eigen::Matrix3d>& R, const Eigen::MatrixXd& J_rest,
+                                                   Eigen::MatrixXd* J) const {
+  const int nb = static_cast<int>(bones_.size());
+  for (int b : fk_bones_) {
+    const auto [c, p] = bones_[b];
+    J->row(c) = J->row(p) + (R[b] * (J_rest.row(c) - J_rest.row(p)).transpose()).transpose();
+  }
+  BoneMotions M;
+  M.R = R;
+  M.t.resize(nb, 3);
+  for (int b = 0; b < nb; ++b) {
+    const int p = bones_[b].second;
+    M.t.row(b) = J->row(p) - (R[b] * J_rest.row(p).transpose()).transpose();
+  }
+  return M;
+}
+
+BoneMotions HarmonicRetargeter::source_base(const Eigen::MatrixXd& Xs, Eigen::MatrixXd* Js_base,
+                                            std::vector<Eigen::Matrix3d>* R) const {
+  const BoneMotions Mk = source_bone_motions(Xs);
+  const int m = static_cast<int>(Js_rest_.rows()), nb = static_cast<int>(bones_.size());
+  Eigen::MatrixXd Jk = Eigen::MatrixXd::Zero(m, 3);
+  Eigen::VectorXd count = Eigen::VectorXd::Zero(m);
+  for (int b = 0; b < nb; ++b)
+    for (int j : {bones_[b].first, bones_[b].second}) {
+      Jk.row(j) += (Mk.R[b] * Js_rest_.row(j).transpose()).transpose() + Mk.t.row(b);
+      count[j] += 1;
+    }
+  for (int j = 0; j < m; ++j)
+    Jk.row(j) = count[j] > 0 ? Eigen::RowVector3d(Jk.row(j) / count[j]) : Eigen::RowVector3d(Js_rest_.row(j));
+  *R = Mk.R;
+  for (int b = 0; b < nb; ++b) {
+    const auto [c, p] = bones_[b];
+    const Eigen::Vector3d s0 = Mk.R[b] * (Js_rest_.row(c) - Js_rest_.row(p)).transpose();
+    const Eigen::Vector3d s1 = (Jk.row(c) - Jk.row(p)).transpose();
+    if (s0.norm() > 1e-12 && s1.norm() > 1e-12)
+      (*R)[b] = Eigen::Quaterniond::FromTwoVectors(s0, s1).toRotationMatrix() * Mk.R[b];
+  }
+  *Js_base = Jk;  // roots stay where the fits put them; FK fills the rest
+  return forward_kinematics(*R, Js_rest_, Js_base);
+}
+
 RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) const {
   RetargetFrame out;
   if (!ready_) {
@@ -292,15 +460,35 @@ RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) cons
   // source joints f_s(J_s) = Ks Ws (Eq. 2) and the Jacobians Jsᵀ = Ds Ws (Eq. 4, 14) enter
   // through the precomposed operators.
   const Eigen::MatrixXd Xs = retarget_detail::to_working(V_source, cs_, Ls_, Eigen::Matrix3d::Identity());
-  const Eigen::MatrixXd bs = src_map_.collocation_positions(Xs);
+  Eigen::MatrixXd bs = src_map_.collocation_positions(Xs);
+  // Articulated base: the map fits what the bones' motions leave (bs − B_s). The motions: each
+  // bone's rigid fit, the joints where the fits of the bones meeting there put them (mean), each
+  // bone turned to point along its joints (twist from the fit), and positions by forward
+  // kinematics from the roots — the same construction on the target with its own rest bones,
+  // so that a character retargeted onto itself gets the same base on both sides.
+  BoneMotions Ms, Mt;
+  Eigen::MatrixXd Js_base, J_base;
+  if (base_on_) {
+    std::vector<Eigen::Matrix3d> R;
+    Ms = source_base(Xs, &Js_base, &R);
+    const int m = static_cast<int>(Js_rest_.rows());
+    bs -= apply_bone_motions(blend_colloc_s_, colloc_rest_s_, Ms);
+    J_base = Jt_rest_;
+    for (int r = 0; r < m; ++r)
+      if (joint_root_[r] == r) J_base.row(r) = Jt_rest_.row(r) + scale_ * (Js_base.row(r) - Js_rest_.row(r));
+    Mt = forward_kinematics(R, Jt_rest_, &J_base);
+  }
   const Eigen::MatrixXd Ys = src_map_.project(bs);
   out.fit_residual = std::sqrt(std::max(0.0, bs.squaredNorm() - Ys.squaredNorm()) /
                                std::max<Eigen::Index>(1, bs.rows()));
-  const Eigen::MatrixXd Js_now = KsJ_ * Ys;  // f_s at the used source joints
+  Eigen::MatrixXd Js_now = KsJ_ * Ys;  // f_s at the used source joints
+  if (base_on_) Js_now += Js_base;
 
   // E_position: the anchor follows the source anchor's displacement, scaled (leg-length ratio).
   const Eigen::MatrixXd p_anchor =
       Jt_rest_.row(anchor_) + scale_ * (Js_now.row(anchor_) - Js_rest_.row(anchor_));
+  // With the base every term below asks the map for the residual only (the base maps each rest
+  // joint exactly to J_base).
 
   // E_bone, first linearisation: each target bone turns like its source bone, by the minimal
   // rotation taking the source rest bone to the fitted source bone f_s(c) − f_s(p). (The mean
@@ -312,14 +500,24 @@ RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) cons
     const Eigen::Vector3d s0 = (Js_rest_.row(c) - Js_rest_.row(p)).transpose();
     const Eigen::Vector3d s1 = (Js_now.row(c) - Js_now.row(p)).transpose();
     const Eigen::Vector3d t0 = (Jt_rest_.row(c) - Jt_rest_.row(p)).transpose().normalized();
-    if (s0.norm() > 1e-12 && s1.norm() > 1e-12)
+    if (base_on_)
+      dirs.row(b) = (Mt.R[b] * t0).transpose();  // the bone's rotation in the base
+    else if (s0.norm() > 1e-12 && s1.norm() > 1e-12)
       dirs.row(b) = (Eigen::Quaterniond::FromTwoVectors(s0, s1) * t0).transpose();
     else
       dirs.row(b) = t0.transpose();
   }
   // Eq. 18 with the bone term re-linearised around the current target joints (keep each bone's
   // direction, restore its length); only the joints are needed until the last solve.
-  Eigen::MatrixXd Jt_fixed = KtGa_ * Ys + Ktgp_ * p_anchor;  // joints without the bone term
+  // Bone-term right-hand side: d̂ minus the base's own bone direction (0 when the map adds
+  // nothing to the bone).
+  Eigen::MatrixXd base_dirs = Eigen::MatrixXd::Zero(nb, 3);
+  if (base_on_)
+    for (int b = 0; b < nb; ++b)
+      base_dirs.row(b) = (J_base.row(bones_[b].first) - J_base.row(bones_[b].second)) / rest_len_[b];
+  const Eigen::MatrixXd p_map = base_on_ ? Eigen::MatrixXd(p_anchor - J_base.row(anchor_)) : p_anchor;
+  Eigen::MatrixXd Jt_fixed = KtGa_ * Ys + Ktgp_ * p_map;  // joints without the bone term
+  if (base_on_) Jt_fixed += J_base;
   // Context graph (Eq. 11, 12): per frame only right-hand sides. Each bone's rotation is the polar
   // factor of the source map's Jacobian at the source bone's midpoint (Eq. 14 at that point).
   Eigen::MatrixXd W_graph;
@@ -339,24 +537,25 @@ RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) cons
     W_graph = Gsp_pos_ * Pa + Gsp_corr_ * rotated(sp_corr_, sp_bone_) + Gvol_ * rotated(vol_delta_, vol_bone_);
     Jt_fixed += Kt_joints_ * W_graph;
   }
-  Eigen::MatrixXd Jt_now = nb > 0 ? Eigen::MatrixXd(Jt_fixed + KtGb_ * dirs) : Jt_fixed;
+  Eigen::MatrixXd Jt_now = nb > 0 ? Eigen::MatrixXd(Jt_fixed + KtGb_ * (dirs - base_dirs)) : Jt_fixed;
   const int relinearisations = nb > 0 ? std::max(0, opt_.bone_iterations) : 0;
   for (int it = 0; it < relinearisations; ++it) {
     for (int b = 0; b < nb; ++b) {
       const Eigen::RowVector3d d = Jt_now.row(bones_[b].first) - Jt_now.row(bones_[b].second);
       if (d.norm() > 1e-12) dirs.row(b) = d / d.norm();
     }
-    Jt_now = Jt_fixed + KtGb_ * dirs;
+    Jt_now = Jt_fixed + KtGb_ * (dirs - base_dirs);
   }
-  Eigen::MatrixXd Wt = Ga_ * Ys + gp_ * p_anchor;
-  if (nb > 0) Wt.noalias() += Gb_ * dirs;
+  Eigen::MatrixXd Wt = Ga_ * Ys + gp_ * p_map;
+  if (nb > 0) Wt.noalias() += Gb_ * (dirs - base_dirs);
   if (graph_on_) Wt += W_graph;
   if (!Wt.allFinite()) {
     out.status = Status::error(StatusCode::NumericalError, "synthesized coefficients are not finite");
     return out;
   }
   // Eq. 6: V = Kt Wt for every target vertex, back to target units and axes.
-  const Eigen::MatrixXd Vw = transposed_times_n3(KtT_all_, Wt);
+  Eigen::MatrixXd Vw = transposed_times_n3(KtT_all_, Wt);
+  if (base_on_) Vw += apply_bone_motions(blend_verts_t_, Xt_rest_, Mt);
   out.V = (Vw * R_) * Lt_;
   out.V.rowwise() += ct_;
   out.joints = (Jt_now * R_) * Lt_;

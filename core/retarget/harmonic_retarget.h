@@ -49,6 +49,7 @@
 
 #include "common/progress.h"
 #include "common/status.h"
+#include "retarget/bone_blend.h"
 #include "retarget/context_graph.h"
 #include "retarget/harmonic_map.h"
 #include "retarget/harmonic_synthesis.h"
@@ -83,6 +84,17 @@ struct HarmonicRetargetOptions {
   int up_axis = 1;              // source up axis (0 x, 1 y, 2 z) for anchor heights; glTF is +Y
   bool align_axes = true;       // rotate the target into the source's axes (snapped Kabsch on joints)
   double joint_tolerance = 0.01;// joints within this × bbox diagonal outside the surface count as inside
+
+  // Articulated base (not in the paper; docs/retarget.md "Articulated base"): each source frame's
+  // bones get a rigid motion (least-squares fit of the source vertices each bone dominates), the
+  // target's bones the same rotations by forward kinematics from its own rest joints and the
+  // anchor trajectory, and both surfaces follow them by distance-blended weights (bone_blend.h).
+  // The MFS maps then carry only the residual — the fit's floor (0.011 of the height with 260
+  // singularities on KayKit's rigid parts) no longer applies to the articulated motion. With
+  // the context graph on, the base is off (not combined yet; a warning says so).
+  bool articulated_base = true;
+  double base_fit_weight = 0.3;     // a source vertex joins a bone's rigid fit from this weight on (weighed by w²)
+  int base_frames = 16;             // source poses the job hands over for learning the weights (spread over all clips)
 
   // Context graph (paper Sec. 6, Eq. 11–12; see "Context graph" above precompute()).
   bool context_graph = false;   // add E_spatial and E_volume (docs/retarget.md: measured, off by default)
@@ -139,6 +151,10 @@ class HarmonicRetargeter {
   // of these source frames (same layout as source.V; e.g. samples of the clip) — and only the node
   // positions change per frame. Call before precompute; empty = the calibration pose only.
   void set_graph_frames(std::vector<Eigen::MatrixXd> frames) { graph_frames_ = std::move(frames); }
+  // Articulated base: source frames (same layout as source.V; e.g. samples of the clip) from
+  // which each source vertex's bone weights are learned. Call before precompute; empty = weights
+  // by distance to the bones on both sides.
+  void set_base_frames(std::vector<Eigen::MatrixXd> frames) { base_frames_ = std::move(frames); }
 
   // Target pose for one source frame V_source (same layout as source.V).
   RetargetFrame retarget(const Eigen::MatrixXd& V_source) const;
@@ -169,6 +185,17 @@ class HarmonicRetargeter {
                              const Eigen::MatrixXi& Ft, const TriangleBvh& bvh_s, const TriangleBvh& bvh_t,
                              const HarmonicRetargetOptions& opt);
 
+  // Articulated base: bone motions of a source frame (working frame), and the target joints they
+  // give by forward kinematics (rows of used joints) with the target bones' motions.
+  BoneMotions source_bone_motions(const Eigen::MatrixXd& Xs) const;
+  // The base's motions of a source frame: rigid fits, joints where they meet, bones turned onto
+  // those joints (rotations R), FK from the roots (joints Js_base).
+  BoneMotions source_base(const Eigen::MatrixXd& Xs, Eigen::MatrixXd* Js_base, std::vector<Eigen::Matrix3d>* R) const;
+  // J: rows of roots set on entry; the other joints follow their bones' rotations R from the rest
+  // joints J_rest. Returns the bones' motions (R, translations) that map J_rest to J.
+  BoneMotions forward_kinematics(const std::vector<Eigen::Matrix3d>& R, const Eigen::MatrixXd& J_rest,
+                                 Eigen::MatrixXd* J) const;
+
   bool ready_ = false;
   HarmonicRetargetOptions opt_;
   std::vector<std::string> warnings_;
@@ -195,6 +222,15 @@ class HarmonicRetargeter {
   Eigen::VectorXd rest_len_world_;
   HarmonicSynthesis synth_;
   int term_affine_ = -1, term_position_ = -1, term_bone_ = -1;
+  // Articulated base.
+  bool base_on_ = false;
+  std::vector<Eigen::MatrixXd> base_frames_;
+  Eigen::MatrixXd Xs_rest_, Xt_rest_, colloc_rest_s_;  // working frames
+  std::vector<std::vector<int>> base_fit_set_;         // per bone: source vertices of its rigid fit
+  std::vector<std::vector<double>> base_fit_w_;        // and their weights in it
+  BoneBlend blend_colloc_s_, blend_verts_t_;
+  std::vector<int> fk_bones_;                          // bones_ indices, parents before children
+  std::vector<int> joint_root_;                        // per used joint: the root of its tree
   // Context graph (Sec. 6).
   std::vector<Eigen::MatrixXd> graph_frames_;
   bool graph_on_ = false;

@@ -6,6 +6,7 @@ list(APPEND MM_CORE_SOURCES
   core/retarget/harmonic_retarget.cpp
   core/retarget/context_graph.cpp
   core/retarget/nonrigid_icp.cpp
+  core/retarget/bone_blend.cpp
   core/retarget/harmonic_retarget_graph.cpp
   core/retarget/lbs_baseline.cpp
   core/retarget/curve_skeleton.cpp

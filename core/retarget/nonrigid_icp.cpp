@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
-#include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
@@ -38,47 +36,6 @@ std::vector<std::pair<int, int>> triangle_edges(const Eigen::MatrixXi& F) {
   std::sort(e.begin(), e.end());
   e.erase(std::unique(e.begin(), e.end()), e.end());
   return e;
-}
-
-Eigen::MatrixXd articulated_points(const Eigen::MatrixXd& P, const Eigen::MatrixXd& J0, const Eigen::MatrixXd& J1,
-                                   const std::vector<std::pair<int, int>>& bones) {
-  struct Motion {
-    Eigen::Vector3d a, b;  // bone segment in the template frame
-    Eigen::Matrix3d R;
-    Eigen::Vector3d t;     // x' = R x + t
-  };
-  std::vector<Motion> m;
-  for (const auto& [c, p] : bones) {
-    const Eigen::Vector3d a = J0.row(p).transpose(), b = J0.row(c).transpose();
-    const Eigen::Vector3d u = b - a, v = J1.row(c).transpose() - J1.row(p).transpose();
-    if (!(u.norm() > 0 && v.norm() > 0)) continue;
-    const Eigen::Matrix3d R = Eigen::Quaterniond::FromTwoVectors(u, v).toRotationMatrix();
-    m.push_back({a, b, R, J1.row(p).transpose() - R * a});
-  }
-  Eigen::MatrixXd Q = P;
-  if (m.empty()) return Q;
-  const double eps = 1e-9 * std::max(1.0, (J0.colwise().maxCoeff() - J0.colwise().minCoeff()).norm());
-  std::vector<double> d(m.size());
-  for (Eigen::Index i = 0; i < P.rows(); ++i) {
-    const Eigen::Vector3d x = P.row(i).transpose();
-    double dmin = std::numeric_limits<double>::infinity();
-    for (size_t b = 0; b < m.size(); ++b) {
-      const Eigen::Vector3d ab = m[b].b - m[b].a;
-      const double s = std::clamp((x - m[b].a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
-      d[b] = std::max(eps, (x - m[b].a - s * ab).norm());
-      dmin = std::min(dmin, d[b]);
-    }
-    Eigen::Vector3d y = Eigen::Vector3d::Zero();
-    double wsum = 0;
-    for (size_t b = 0; b < m.size(); ++b) {
-      if (d[b] > 2 * dmin) continue;
-      const double w = std::pow(dmin / d[b], 4);
-      y += w * (m[b].R * x + m[b].t);
-      wsum += w;
-    }
-    Q.row(i) = (y / wsum).transpose();
-  }
-  return Q;
 }
 
 NonrigidIcpResult nonrigid_icp(const Eigen::MatrixXd& P, const std::vector<std::pair<int, int>>& edges,

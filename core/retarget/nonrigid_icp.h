@@ -60,17 +60,6 @@ NonrigidIcpResult nonrigid_icp(const Eigen::MatrixXd& P, const std::vector<std::
                                const Eigen::MatrixXd& landmark_point, const Eigen::MatrixXd& landmark_target,
                                const NonrigidIcpOptions& opt = {});
 
-// A start for templates far from the target's pose (e.g. a rest pose onto a walk frame, where
-// closest points pull a swung arm onto the body and the stiff first steps never let go): each
-// point moves with the bones nearest to it. Bone b = (child, parent) joint rows of J0 (template
-// frame) and J1 (target frame); its motion is the smallest rotation taking the direction
-// J0(child) − J0(parent) onto J1(child) − J1(parent) (no twist), about the parent end, carried to
-// J1(parent). A point blends the motions of the bones within twice its nearest bone's distance,
-// weights ∝ d⁻⁴ (d: distance to the bone segment). Rows of P with no bones: unchanged.
-// Run nonrigid_icp on the result (and on the joints moved the same way as landmark points).
-Eigen::MatrixXd articulated_points(const Eigen::MatrixXd& P, const Eigen::MatrixXd& J0, const Eigen::MatrixXd& J1,
-                                   const std::vector<std::pair<int, int>>& bones);
-
 // Symmetric k-nearest-neighbour edges (i < j, sorted) over the rows of P: a stiffness graph for
 // point templates (brute force, O(#P²); meant for a few thousand points).
 std::vector<std::pair<int, int>> knn_edges(const Eigen::MatrixXd& P, int k);

@@ -1,0 +1,188 @@
+#include "retarget/bone_blend.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+namespace mm {
+
+std::pair<int, double> BoneBlend::dominant(int i) const {
+  std::pair<int, double> best{-1, 0.0};
+  for (int k = ptr[i]; k < ptr[i + 1]; ++k)
+    if (w[k] > best.second) best = {bone[k], w[k]};
+  return best;
+}
+
+BoneBlend bone_blend(const Eigen::MatrixXd& P, const Eigen::MatrixXd& J, const std::vector<std::pair<int, int>>& bones,
+                     double band) {
+  BoneBlend out;
+  const int n = static_cast<int>(P.rows()), nb = static_cast<int>(bones.size());
+  out.ptr.reserve(n + 1);
+  std::vector<std::pair<double, int>> d(nb);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d x = P.row(i).transpose();
+    double dmin = std::numeric_limits<double>::infinity();
+    int valid = 0;
+    for (int b = 0; b < nb; ++b) {
+      const Eigen::Vector3d a = J.row(bones[b].second).transpose(), c = J.row(bones[b].first).transpose();
+      const Eigen::Vector3d ab = c - a;
+      const double L2 = ab.squaredNorm();
+      if (!(L2 > 0)) {
+        d[b] = {std::numeric_limits<double>::infinity(), b};
+        continue;
+      }
+      const double s = std::clamp((x - a).dot(ab) / L2, 0.0, 1.0);
+      d[b] = {(x - a - s * ab).norm(), b};
+      dmin = std::min(dmin, d[b].first);
+      ++valid;
+    }
+    if (valid > 0) {
+      std::partial_sort(d.begin(), d.begin() + std::min(nb, BoneBlend::kMaxBones), d.end());
+      const size_t first = out.bone.size();
+      if (dmin <= 1e-12 * (1.0 + x.norm())) {
+        for (int k = 0; k < std::min(nb, BoneBlend::kMaxBones) && d[k].first <= 1e-12 * (1.0 + x.norm()); ++k) {
+          out.bone.push_back(d[k].second);
+          out.w.push_back(1.0);
+        }
+      } else {
+        const double floor = std::pow(band * dmin, -4.0);
+        for (int k = 0; k < std::min(nb, BoneBlend::kMaxBones) && d[k].first < band * dmin; ++k) {
+          out.bone.push_back(d[k].second);
+          out.w.push_back(std::pow(d[k].first, -4.0) - floor);
+        }
+      }
+      double sum = 0;
+      for (size_t k = first; k < out.w.size(); ++k) sum += out.w[k];
+      for (size_t k = first; k < out.w.size(); ++k) out.w[k] /= sum;
+    }
+    out.ptr.push_back(static_cast<int>(out.bone.size()));
+  }
+  return out;
+}
+
+Eigen::MatrixXd apply_bone_motions(const BoneBlend& blend, const Eigen::MatrixXd& P, const BoneMotions& m) {
+  Eigen::MatrixXd Y = P;
+  for (int i = 0; i < blend.rows(); ++i) {
+    if (blend.ptr[i] == blend.ptr[i + 1]) continue;
+    const Eigen::Vector3d x = P.row(i).transpose();
+    Eigen::Vector3d y = Eigen::Vector3d::Zero();
+    for (int k = blend.ptr[i]; k < blend.ptr[i + 1]; ++k) {
+      const int b = blend.bone[k];
+      y += blend.w[k] * (m.R[b] * x + m.t.row(b).transpose());
+    }
+    Y.row(i) = y.transpose();
+  }
+  return Y;
+}
+
+BoneBlend learn_bone_weights(const Eigen::MatrixXd& X, const std::vector<Eigen::MatrixXd>& Y,
+                             const std::vector<BoneMotions>& M, const BoneBlend& candidates) {
+  BoneBlend out;
+  const int nf = static_cast<int>(std::min(Y.size(), M.size()));
+  for (int i = 0; i < candidates.rows(); ++i) {
+    const int b0 = candidates.ptr[i], k = candidates.ptr[i + 1] - b0;
+    if (k <= 1 || nf == 0) {
+      for (int a = 0; a < k; ++a) out.bone.push_back(candidates.bone[b0 + a]), out.w.push_back(1.0);
+      out.ptr.push_back(static_cast<int>(out.bone.size()));
+      continue;
+    }
+    // Columns: each candidate bone's prediction of the point over the frames.
+    Eigen::MatrixXd A(3 * nf, k);
+    Eigen::VectorXd y(3 * nf), prior(k);
+    const Eigen::Vector3d x = X.row(i).transpose();
+    for (int f = 0; f < nf; ++f) {
+      y.segment<3>(3 * f) = Y[f].row(i).transpose();
+      for (int a = 0; a < k; ++a) {
+        const int b = candidates.bone[b0 + a];
+        A.block<3, 1>(3 * f, a) = M[f].R[b] * x + M[f].t.row(b).transpose();
+      }
+    }
+    for (int a = 0; a < k; ++a) prior[a] = candidates.w[b0 + a];
+    const Eigen::MatrixXd AtA = A.transpose() * A;
+    const double mu = 1e-4 * std::max(1e-300, AtA.trace() / k);
+    // Active set on the simplex: solve the KKT system of the free weights, drop the most negative.
+    std::vector<char> active(k, 1);
+    Eigen::VectorXd w = prior;
+    for (int round = 0; round < k; ++round) {
+      std::vector<int> free;
+      for (int a = 0; a < k; ++a)
+        if (active[a]) free.push_back(a);
+      const int q = static_cast<int>(free.size());
+      Eigen::MatrixXd K = Eigen::MatrixXd::Zero(q + 1, q + 1);
+      Eigen::VectorXd r(q + 1);
+      for (int u = 0; u < q; ++u) {
+        for (int v = 0; v < q; ++v) K(u, v) = AtA(free[u], free[v]);
+        K(u, u) += mu;
+        K(u, q) = K(q, u) = 1;
+        r[u] = A.col(free[u]).dot(y) + mu * prior[free[u]];
+      }
+      r[q] = 1;
+      const Eigen::VectorXd sol = K.fullPivLu().solve(r);
+      w.setZero();
+      int worst = -1;
+      for (int u = 0; u < q; ++u) {
+        w[free[u]] = sol[u];
+        if (sol[u] < 0 && (worst < 0 || sol[u] < w[worst])) worst = free[u];
+      }
+      if (worst < 0 || q == 1) break;
+      active[worst] = 0;
+    }
+    if (!w.allFinite() || w.minCoeff() < 0) w = prior;
+    for (int a = 0; a < k; ++a)
+      if (w[a] > 1e-6) out.bone.push_back(candidates.bone[b0 + a]), out.w.push_back(w[a]);
+    double sum = 0;
+    for (size_t a = out.ptr.back(); a < out.w.size(); ++a) sum += out.w[a];
+    for (size_t a = out.ptr.back(); a < out.w.size(); ++a) out.w[a] /= sum;
+    out.ptr.push_back(static_cast<int>(out.bone.size()));
+  }
+  return out;
+}
+
+BoneBlend interpolate_blend(const BoneBlend& W, const Eigen::MatrixXi& F, const Eigen::VectorXi& face,
+                            const Eigen::MatrixXd& bary, const BoneBlend* fallback) {
+  BoneBlend out;
+  std::vector<std::pair<double, int>> acc;
+  for (Eigen::Index i = 0; i < face.size(); ++i) {
+    acc.clear();
+    if (face[i] >= 0) {
+      for (int c = 0; c < 3; ++c) {
+        const int v = F(face[i], c);
+        for (int k = W.ptr[v]; k < W.ptr[v + 1]; ++k) {
+          const double add = bary(i, c) * W.w[k];
+          auto it = std::find_if(acc.begin(), acc.end(), [&](const auto& e) { return e.second == W.bone[k]; });
+          if (it == acc.end()) acc.push_back({add, W.bone[k]});
+          else it->first += add;
+        }
+      }
+    } else if (fallback) {
+      for (int k = fallback->ptr[i]; k < fallback->ptr[i + 1]; ++k) acc.push_back({fallback->w[k], fallback->bone[k]});
+    }
+    std::sort(acc.begin(), acc.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    if (acc.size() > BoneBlend::kMaxBones) acc.resize(BoneBlend::kMaxBones);
+    double sum = 0;
+    for (const auto& e : acc) sum += std::max(0.0, e.first);
+    for (const auto& e : acc)
+      if (e.first > 0 && sum > 0) out.bone.push_back(e.second), out.w.push_back(e.first / sum);
+    out.ptr.push_back(static_cast<int>(out.bone.size()));
+  }
+  return out;
+}
+
+Eigen::MatrixXd articulated_points(const Eigen::MatrixXd& P, const Eigen::MatrixXd& J0, const Eigen::MatrixXd& J1,
+                                   const std::vector<std::pair<int, int>>& bones) {
+  BoneMotions m;
+  m.R.resize(bones.size(), Eigen::Matrix3d::Identity());
+  m.t = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(bones.size()), 3);
+  for (size_t b = 0; b < bones.size(); ++b) {
+    const auto [c, p] = bones[b];
+    const Eigen::Vector3d u = (J0.row(c) - J0.row(p)).transpose(), v = (J1.row(c) - J1.row(p)).transpose();
+    if (u.norm() > 0 && v.norm() > 0) m.R[b] = Eigen::Quaterniond::FromTwoVectors(u, v).toRotationMatrix();
+    m.t.row(b) = J1.row(p) - (m.R[b] * J0.row(p).transpose()).transpose();
+  }
+  return apply_bone_motions(bone_blend(P, J0, bones), P, m);
+}
+
+}  // namespace mm
