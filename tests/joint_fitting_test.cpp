@@ -523,8 +523,8 @@ TEST(JointFittingRetarget, AutoJointsWithinATquarterOfTrueJoints) {
   // Knight → Barbarian against Barbarian's own Walking_A, and self-retargeting of the Knight.
   // The paper's maps alone (articulated base off) — the 1.25× of issue 14: measured true 0.0219,
   // auto 0.0260 (1.19×). With the articulated base (the default since the fifteenth session) the
-  // bones pivot at the fitted joints, so joint placement matters more: true 0.0078, auto 0.0174
-  // (2.2×, NOT within 1.25×) — still below the paper's maps with the true joints.
+  // bones pivot at the fitted joints, so joint placement matters more: true 0.0075, auto 0.0104
+  // (1.39×, NOT within 1.25×) — still well below the paper's maps with the true joints.
   for (const bool base : {false, true}) {
     auto truej = jf_job("anim/KayKit/Knight.glb", "anim/KayKit/Barbarian.glb", "", base);
     auto autoj = jf_job("anim/KayKit/Knight.glb", "anim/KayKit/Barbarian.glb", "auto", base);
@@ -543,7 +543,7 @@ TEST(JointFittingRetarget, AutoJointsWithinATquarterOfTrueJoints) {
       RecordProperty("knight_barbarian_auto", std::to_string(ea));
       EXPECT_LE(ea, 1.25 * et);
     } else {
-      EXPECT_LE(ea, 0.02);
+      EXPECT_LE(ea, 0.015);
     }
   }
   for (const char* c : {"anim/KayKit/Knight.glb", "anim/CesiumMan/CesiumMan.glb"}) {

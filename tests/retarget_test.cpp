@@ -290,8 +290,8 @@ TEST(RetargetReal, SelfRetargetingCesiumMan) {
   RecordProperty("mean_error_over_height", std::to_string(e.mean));
   RecordProperty("max_frame_error_over_height", std::to_string(e.max));
   std::cout << "[ CesiumMan self-retargeting ] mean " << e.mean << " max frame " << e.max << " of height\n";
-  // Issue 15: stays <= 0.005. Measured 0.0010 with the articulated base, 0.0042 with the paper's
-  // maps alone (the default).
+  // Issue 15: stays <= 0.005. Measured 0.0011 with the articulated base (the default), 0.0042
+  // with the paper's maps alone.
   EXPECT_LE(e.mean, 0.005);
 }
 
@@ -315,7 +315,7 @@ TEST(RetargetReal, SelfRetargetingKayKitKnight) {
   const mm::SequenceError e = self_error(*j);
   RecordProperty("mean_error_over_height", std::to_string(e.mean));
   std::cout << "[ Knight self-retargeting, articulated base ] mean " << e.mean << " max frame " << e.max << " of height\n";
-  // Issue 15: <= 0.006. Measured 0.0045 with the articulated base: the bones' motions carry the
+  // Issue 15: <= 0.006. Measured 0.0039 with the articulated base: the bones' motions carry the
   // six rigid parts and the map only the rest.
   EXPECT_LE(e.mean, 0.006);
   // The paper's maps alone: with 260 singularities the MFS fit (Eq. 13) of the six parts is 0.011
@@ -350,16 +350,15 @@ TEST(RetargetReal, SelfRetargetingKayKitBarbarian) {
   const mm::SequenceError e = self_error(*j);
   RecordProperty("mean_error_over_height", std::to_string(e.mean));
   std::cout << "[ Barbarian self-retargeting ] mean " << e.mean << " max frame " << e.max << " of height\n";
-  // Issue 15: <= 0.006. Measured 0.0046 with the articulated base (0.013 with the paper's maps).
+  // Issue 15: <= 0.006. Measured 0.0049 with the articulated base (0.013 with the paper's maps).
   EXPECT_LE(e.mean, 0.006);
 }
 
 TEST(RetargetReal, KnightToBarbarianHarmonicVsLbs) {
   // Issue 15: <= 0.008 of the height against Barbarian's own clip, on Walking_A and an arm-heavy
   // clip. Measured with the articulated base (weights learned from 16 poses over all of the
-  // Knight's clips) / the paper's maps alone / LBS: Walking_A 0.0086 (wasm 0.0087) / 0.0219 /
-  // 0.0031 (NOT met: 0.0078 when the weights were learned from Walking_A alone, which made a
-  // result depend on the clip prepared), Cheer 0.0079 (wasm 0.0080) / 0.0154 / 0.0030.
+  // Knight's clips) / the paper's maps alone / LBS: Walking_A 0.0075 / 0.0219 / 0.0031, Cheer
+  // 0.0074 / 0.0154 / 0.0030.
   for (const char* clip_name : {"Walking_A", "Cheer"}) {
   auto h = job("anim/KayKit/Knight.glb", "anim/KayKit/Barbarian.glb", clip_name, 10, -1, "",
                mm::app::RetargetMethod::Harmonic, base_on);
@@ -381,7 +380,7 @@ TEST(RetargetReal, KnightToBarbarianHarmonicVsLbs) {
   RecordProperty("lbs_error_over_height", std::to_string(el.mean));
   std::cout << "[ Knight -> Barbarian vs Barbarian's own " << clip_name << " ] harmonic " << eh.mean << ", LBS "
             << el.mean << " of height\n";
-  EXPECT_LE(eh.mean, std::string(clip_name) == "Walking_A" ? 0.009 : 0.0082) << clip_name;
+  EXPECT_LE(eh.mean, 0.008) << clip_name;
   EXPECT_LE(eh.mean, 3 * el.mean) << clip_name;  // same rig: within 3x of the LBS baseline
   EXPECT_LT(el.mean, 0.05) << clip_name;
   }
@@ -406,8 +405,8 @@ TEST(RetargetReal, FoxToWolfWithPlacedJoints) {
   RecordProperty("bone_length_error_mean", std::to_string(be.mean));
   RecordProperty("bone_length_error_max", std::to_string(be.max));
   std::cout << "[ Fox -> wolf0 ] bone-length error mean " << be.mean << " max " << be.max << "\n";
-  // Issue 15: not worse than the paper's maps alone (mean 0.029). Measured 0.018 with the
-  // articulated base (natively and in wasm).
+  // Issue 15: not worse than the paper's maps alone (mean 0.029). Measured 0.016 with the
+  // articulated base.
   EXPECT_LE(be.mean, 0.029);
   EXPECT_LT(be.max, 0.3);
 }
@@ -523,3 +522,53 @@ TEST(RetargetGolden, KnightToBarbarianFrames) {
     for (int i = 0; i < n; ++i) G.row(f * n + i) = frames[f].row(std::min<int>(i * 37, frames[f].rows() - 1));
   mm::test::expect_golden("retarget_knight_barbarian", G, 1e-3);
 }
+
+
+// The articulated base must be continuous in its input: a first version jumped with last-bit
+// differences (learned-weight active sets, hard weight thresholds, a top-4 cut, ray decisions),
+// so that native and wasm differed by 1.5% of the height at one vertex. Moving every input vertex
+// by 1e-13 of the height must move no output vertex by more than 1e-3 of the height: measured
+// 3.9e-5 (the learned weights amplify, smoothly; 5 poses here, 16 in the job); before the fixes
+// the same kind of change moved a Barbarian vertex by 0.13 of the height, a wolf vertex by 0.21.
+TEST(RetargetReal, ArticulatedBaseIsContinuousInItsInput) {
+  const mm::io::LoadResult src = mm::io::load_asset(mm::test::data_path("anim/KayKit/Knight.glb"));
+  const mm::io::LoadResult tgt = mm::io::load_asset(mm::test::data_path("anim/KayKit/Barbarian.glb"));
+  ASSERT_TRUE(src.status.ok() && tgt.status.ok());
+  const mm::io::CharacterResult s = mm::io::animated_character(src.asset), t = mm::io::animated_character(tgt.asset);
+  ASSERT_TRUE(s.status.ok() && t.status.ok());
+  int clip = -1;
+  ASSERT_TRUE(mm::find_clip(s.character, "Walking_A", &clip).ok());
+  std::vector<Eigen::MatrixXd> poses;
+  for (double u : {0.1, 0.3, 0.5, 0.7, 0.9}) {
+    const mm::AnimationClip& c = s.character.clips[clip];
+    poses.push_back(mm::pose_at(s.character, clip, c.start + u * (c.end - c.start)));
+  }
+  const double h = height(t.character.V_rest);
+  auto run = [&](double eps) {
+    // Each vertex (source rest and poses, target rest) moved by eps·h in a direction of its own
+    // (a scaling would be undone exactly by the working frames).
+    auto nudge = [&](Eigen::MatrixXd V) {
+      for (Eigen::Index i = 0; i < V.rows(); ++i)
+        V.row(i) += eps * h * Eigen::RowVector3d(std::sin(1.3 * i), std::cos(2.1 * i), std::sin(0.7 * i + 1));
+      return V;
+    };
+    const mm::RetargetCharacter S{nudge(s.character.V_rest), s.character.F, mm::character_joints(s.character)};
+    const mm::RetargetCharacter T{nudge(t.character.V_rest), t.character.F, mm::character_joints(t.character)};
+    std::vector<Eigen::MatrixXd> frames;
+    for (const auto& P : poses) frames.push_back(nudge(P));
+    mm::HarmonicRetargeter H;
+    H.set_base_frames(frames);
+    mm::HarmonicRetargetOptions o;
+    o.articulated_base = true;
+    EXPECT_TRUE(H.precompute(S, T, {}, o).ok());
+    std::vector<Eigen::MatrixXd> out;
+    for (const auto& P : frames) out.push_back(H.retarget(P).V);
+    return out;
+  };
+  const auto a = run(0), b = run(1e-13);
+  double worst = 0;
+  for (size_t k = 0; k < a.size(); ++k) worst = std::max(worst, (a[k] - b[k]).rowwise().norm().maxCoeff() / h);
+  std::cout << "[ articulated base, 1e-13 input change ] largest output change " << worst << " of the height\n";
+  EXPECT_LT(worst, 1e-3);
+}
+

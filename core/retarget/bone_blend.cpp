@@ -40,19 +40,27 @@ BoneBlend bone_blend(const Eigen::MatrixXd& P, const Eigen::MatrixXd& J, const s
       ++valid;
     }
     if (valid > 0) {
-      std::partial_sort(d.begin(), d.begin() + std::min(nb, BoneBlend::kMaxBones), d.end());
+      std::sort(d.begin(), d.end());
       const size_t first = out.bone.size();
-      if (dmin <= 1e-12 * (1.0 + x.norm())) {
-        for (int k = 0; k < std::min(nb, BoneBlend::kMaxBones) && d[k].first <= 1e-12 * (1.0 + x.norm()); ++k) {
+      const double on_bone = 1e-12 * (1.0 + x.norm());
+      if (dmin <= on_bone) {
+        for (int k = 0; k < std::min(nb, BoneBlend::kMaxBones) && d[k].first <= on_bone; ++k) {
           out.bone.push_back(d[k].second);
           out.w.push_back(1.0);
         }
       } else {
+        // Raw weights of the bones in the band, largest first; beyond kMaxBones the next raw
+        // weight is subtracted from the kept ones, so that two bones trading places at the cut
+        // do not make the weights jump.
         const double floor = std::pow(band * dmin, -4.0);
-        for (int k = 0; k < std::min(nb, BoneBlend::kMaxBones) && d[k].first < band * dmin; ++k) {
-          out.bone.push_back(d[k].second);
-          out.w.push_back(std::pow(d[k].first, -4.0) - floor);
-        }
+        std::vector<double> raw;
+        for (int k = 0; k < nb && d[k].first < band * dmin; ++k) raw.push_back(std::pow(d[k].first, -4.0) - floor);
+        const double cut = raw.size() > BoneBlend::kMaxBones ? raw[BoneBlend::kMaxBones] : 0.0;
+        for (size_t k = 0; k < std::min<size_t>(raw.size(), BoneBlend::kMaxBones); ++k)
+          if (raw[k] - cut > 0) {
+            out.bone.push_back(d[k].second);
+            out.w.push_back(raw[k] - cut);
+          }
       }
       double sum = 0;
       for (size_t k = first; k < out.w.size(); ++k) sum += out.w[k];
@@ -102,33 +110,44 @@ BoneBlend learn_bone_weights(const Eigen::MatrixXd& X, const std::vector<Eigen::
     }
     for (int a = 0; a < k; ++a) prior[a] = candidates.w[b0 + a];
     const Eigen::MatrixXd AtA = A.transpose() * A;
+    const Eigen::VectorXd Aty = A.transpose() * y;
+    // The pull towards the prior grows as the prior weight vanishes (μ / prior), so a bone at
+    // the edge of the candidates gets no weight it did not have: the weights stay continuous in
+    // the point. The exact minimiser on the simplex: every support subset is tried (k ≤ 4).
     const double mu = 1e-4 * std::max(1e-300, AtA.trace() / k);
-    // Active set on the simplex: solve the KKT system of the free weights, drop the most negative.
-    std::vector<char> active(k, 1);
+    Eigen::VectorXd pen(k);
+    for (int a = 0; a < k; ++a) pen[a] = mu / std::max(prior[a], 1e-12);
+    auto objective = [&](const Eigen::VectorXd& v) {
+      double o = v.dot(AtA * v) - 2 * v.dot(Aty);
+      for (int a = 0; a < k; ++a) o += pen[a] * (v[a] - prior[a]) * (v[a] - prior[a]);
+      return o;
+    };
     Eigen::VectorXd w = prior;
-    for (int round = 0; round < k; ++round) {
+    double best = objective(prior);
+    for (int mask = 1; mask < (1 << k); ++mask) {
       std::vector<int> free;
       for (int a = 0; a < k; ++a)
-        if (active[a]) free.push_back(a);
+        if (mask & (1 << a)) free.push_back(a);
       const int q = static_cast<int>(free.size());
       Eigen::MatrixXd K = Eigen::MatrixXd::Zero(q + 1, q + 1);
       Eigen::VectorXd r(q + 1);
       for (int u = 0; u < q; ++u) {
         for (int v = 0; v < q; ++v) K(u, v) = AtA(free[u], free[v]);
-        K(u, u) += mu;
+        K(u, u) += pen[free[u]];
         K(u, q) = K(q, u) = 1;
-        r[u] = A.col(free[u]).dot(y) + mu * prior[free[u]];
+        r[u] = Aty[free[u]] + pen[free[u]] * prior[free[u]];
       }
       r[q] = 1;
       const Eigen::VectorXd sol = K.fullPivLu().solve(r);
-      w.setZero();
-      int worst = -1;
-      for (int u = 0; u < q; ++u) {
-        w[free[u]] = sol[u];
-        if (sol[u] < 0 && (worst < 0 || sol[u] < w[worst])) worst = free[u];
+      Eigen::VectorXd v = Eigen::VectorXd::Zero(k);
+      bool feasible = sol.allFinite();
+      for (int u = 0; u < q && feasible; ++u) {
+        if (sol[u] < 0) feasible = false;
+        v[free[u]] = sol[u];
       }
-      if (worst < 0 || q == 1) break;
-      active[worst] = 0;
+      if (!feasible) continue;
+      const double o = objective(v);
+      if (o < best) best = o, w = v;
     }
     if (!w.allFinite() || w.minCoeff() < 0) w = prior;
     for (int a = 0; a < k; ++a)
@@ -160,12 +179,14 @@ BoneBlend interpolate_blend(const BoneBlend& W, const Eigen::MatrixXi& F, const 
     } else if (fallback) {
       for (int k = fallback->ptr[i]; k < fallback->ptr[i + 1]; ++k) acc.push_back({fallback->w[k], fallback->bone[k]});
     }
-    std::sort(acc.begin(), acc.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::sort(acc.begin(), acc.end(), [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+    // Beyond kMaxBones the next weight is subtracted from the kept ones (no jump at the cut).
+    const double cut = acc.size() > BoneBlend::kMaxBones ? std::max(0.0, acc[BoneBlend::kMaxBones].first) : 0.0;
     if (acc.size() > BoneBlend::kMaxBones) acc.resize(BoneBlend::kMaxBones);
     double sum = 0;
-    for (const auto& e : acc) sum += std::max(0.0, e.first);
+    for (const auto& e : acc) sum += std::max(0.0, e.first - cut);
     for (const auto& e : acc)
-      if (e.first > 0 && sum > 0) out.bone.push_back(e.second), out.w.push_back(e.first / sum);
+      if (e.first - cut > 0 && sum > 0) out.bone.push_back(e.second), out.w.push_back((e.first - cut) / sum);
     out.ptr.push_back(static_cast<int>(out.bone.size()));
   }
   return out;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 
 #include "linalg/polar.h"
 #include "linalg/rigid_fit.h"
@@ -245,9 +246,11 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
     Xt_rest_ = Xt;
     const int nb = static_cast<int>(bones_.size());
     BoneBlend bv = bone_blend(Xs, Js_rest_, bones_);
-    // Each bone's rigid fit: the source vertices it moves with at least base_fit_weight, weighed
-    // by that weight squared (a bone with fewer than 6 takes every vertex it has a share of).
+    // Each bone's rigid fit: the source vertices it has a weight w > base_fit_weight in, weighed
+    // by ((w − τ)/(1 − τ))² (continuous in w: no vertex enters or leaves a fit abruptly); a bone
+    // without such vertices takes every vertex it has a share of, weighed by w².
     auto fit_sets = [&](const BoneBlend& w) {
+      const double tau = std::clamp(opt.base_fit_weight, 0.0, 0.99);
       base_fit_set_.assign(nb, {});
       base_fit_w_.assign(nb, {});
       std::vector<std::vector<int>> loose(nb);
@@ -255,14 +258,18 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
       for (int i = 0; i < w.rows(); ++i)
         for (int k = w.ptr[i]; k < w.ptr[i + 1]; ++k) {
           const int b = w.bone[k];
-          const bool firm = w.w[k] >= opt.base_fit_weight;
-          (firm ? base_fit_set_[b] : loose[b]).push_back(i);
-          (firm ? base_fit_w_[b] : loose_w[b]).push_back(w.w[k] * w.w[k]);
+          const double r = (w.w[k] - tau) / (1 - tau);
+          if (r > 0) {
+            base_fit_set_[b].push_back(i);
+            base_fit_w_[b].push_back(r * r);
+          }
+          loose[b].push_back(i);
+          loose_w[b].push_back(w.w[k] * w.w[k]);
         }
       for (int b = 0; b < nb; ++b)
-        if (base_fit_set_[b].size() < 6) {
-          base_fit_set_[b].insert(base_fit_set_[b].end(), loose[b].begin(), loose[b].end());
-          base_fit_w_[b].insert(base_fit_w_[b].end(), loose_w[b].begin(), loose_w[b].end());
+        if (base_fit_set_[b].size() < 4) {
+          base_fit_set_[b] = loose[b];
+          base_fit_w_[b] = loose_w[b];
         }
     };
     fit_sets(bv);
@@ -289,15 +296,20 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
     if (learned) {
       const SurfaceSamples& C = src_map_.collocation();
       blend_colloc_s_ = interpolate_blend(bv, source.F, C.face, C.barycentric);
-      const BoneCorrespondence bc = bone_correspondence(Xt, bones_, Jt_rest_, Js_rest_, bvh_t, bvh_s);
-      const BoneBlend fallback = bone_blend(Xt, Jt_rest_, bones_);
+      // Each target vertex takes the weights of its counterpart on the source: the target posed
+      // onto the source's rest skeleton by the bones (continuous in the vertex), then the closest
+      // source point. (Bone coordinates by rays, as the surface descriptors use, gave the same
+      // accuracy but jumped between builds: a ray's last-bit crossing decision moved a vertex's
+      // weights wholesale.)
+      const Eigen::MatrixXd Xts = articulated_points(Xt, Jt_rest_, Js_rest_, bones_);
       Eigen::VectorXi face(Xt.rows());
       Eigen::MatrixXd bary(Xt.rows(), 3);
       for (Eigen::Index i = 0; i < Xt.rows(); ++i) {
-        const ClosestPoint cp = bvh_s.closest_point(bc.X.row(i).transpose());
-        face[i] = bc.bone[i] >= 0 ? cp.face : -1;
+        const ClosestPoint cp = bvh_s.closest_point(Xts.row(i).transpose());
+        face[i] = cp.face;
         bary.row(i) = cp.barycentric.transpose();
       }
+      const BoneBlend fallback = bone_blend(Xt, Jt_rest_, bones_);
       blend_verts_t_ = interpolate_blend(bv, source.F, face, bary, &fallback);
     } else {
       blend_colloc_s_ = bone_blend(colloc_rest_s_, Js_rest_, bones_);
@@ -384,10 +396,23 @@ BoneMotions HarmonicRetargeter::source_bone_motions(const Eigen::MatrixXd& Xs) c
       Q.row(k) = Xs.row(set[k]);
       w[k] = base_fit_w_[b][k];
     }
-    const RigidFit f = fit_rigid(P, Q, w);
-    if (f.degenerate) continue;
-    M.R[b] = f.R;
-    M.t.row(b) = f.t.transpose();
+    // Weighted Kabsch with a small pull towards no rotation (1e-3 of the set's spread added to
+    // the cross-covariance): a thin or flat set (an ear, a tail tip) leaves a rotation about its
+    // degenerate axis undetermined, and a plain SVD then picks it from rounding noise.
+    const double ws = w.sum();
+    if (!(ws > 0)) continue;
+    const Eigen::RowVector3d pc = (w.transpose() * P) / ws, qc = (w.transpose() * Q) / ws;
+    const Eigen::MatrixXd Pc = P.rowwise() - pc, Qc = Q.rowwise() - qc;
+    Eigen::Matrix3d H = Pc.transpose() * w.asDiagonal() * Qc;
+    const double spread = (Pc.transpose() * w.asDiagonal() * Pc).trace();
+    H += 1e-3 * spread * Eigen::Matrix3d::Identity();
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+    D(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
+    const Eigen::Matrix3d R = svd.matrixV() * D * svd.matrixU().transpose();
+    if (!R.allFinite()) continue;
+    M.R[b] = R;
+    M.t.row(b) = qc - (R * pc.transpose()).transpose();
     fitted[b] = 1;
   }
   // Bones without a fit (too few or collinear vertices): the motion of the parent's bone.

@@ -91,11 +91,9 @@ struct HarmonicRetargetOptions {
   // anchor trajectory, and both surfaces follow them by distance-blended weights (bone_blend.h).
   // The MFS maps then carry only the residual — the fit's floor (0.011 of the height with 260
   // singularities on KayKit's rigid parts) no longer applies to the articulated motion. With
-  // the context graph on, the base is off (not combined yet; a warning says so). Off by default:
-  // its learned weights and per-vertex correspondences make the result jump with last-bit
-  // differences (native vs wasm: up to 1.5% of the height at the worst vertex), which the
-  // shared goldens (1e-3) do not allow.
-  bool articulated_base = false;
+  // the context graph on, the base is off (not combined yet; a warning says so). Every step is
+  // continuous in the input (weights, fits, correspondences), so native and wasm agree.
+  bool articulated_base = true;
   double base_fit_weight = 0.3;     // a source vertex joins a bone's rigid fit from this weight on (weighed by w²)
   int base_frames = 16;             // source poses the job hands over for learning the weights (spread over all clips)
 
