@@ -238,9 +238,7 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
     s = build_context_graph(Xs, source.F, Xt, target.F, bvh_s, bvh_t, opt);
     if (!s.ok()) return s;
   }
-  base_on_ = opt.articulated_base && !bones_.empty() && !opt.context_graph;
-  if (opt.articulated_base && opt.context_graph)
-    warnings_.push_back("articulated base off: it is not combined with the context graph yet (the paper's maps alone)");
+  base_on_ = opt.articulated_base && !bones_.empty();
   if (base_on_) {
     Xs_rest_ = Xs;
     Xt_rest_ = Xt;
@@ -314,6 +312,23 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
     } else {
       blend_colloc_s_ = bone_blend(colloc_rest_s_, Js_rest_, bones_);
       blend_verts_t_ = bone_blend(Xt, Jt_rest_, bones_);
+    }
+    if (graph_on_) {
+      // The base at the graph's target nodes (on the surface: the vertices' weights there) and
+      // at the volume graph's nodes (surface samples likewise; interior nodes lie on bones).
+      blend_Va_ = interpolate_blend(blend_verts_t_, target.F, graph_.target_face, graph_.target_barycentric);
+      const SurfaceSamples& C = tgt_map_.collocation();
+      const int ns = graph_.volume_surface, nv = static_cast<int>(Xvol_.rows());
+      const BoneBlend inner = bone_blend(Xvol_.bottomRows(nv - ns), Jt_rest_, bones_);
+      const BoneBlend surf = interpolate_blend(blend_verts_t_, target.F, C.face.head(ns), C.barycentric.topRows(ns));
+      blend_vol_ = surf;
+      for (int i = 0; i < inner.rows(); ++i) {
+        for (int k = inner.ptr[i]; k < inner.ptr[i + 1]; ++k) {
+          blend_vol_.bone.push_back(inner.bone[k]);
+          blend_vol_.w.push_back(inner.w[k]);
+        }
+        blend_vol_.ptr.push_back(static_cast<int>(blend_vol_.bone.size()));
+      }
     }
     // Forward-kinematics order: from each root down (bones_ are (child, parent) joint pairs).
     std::vector<std::vector<int>> child_bones(m);
@@ -549,6 +564,10 @@ RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) cons
   if (graph_on_) {
     std::vector<Eigen::Matrix3d> Rb(nb);
     for (int b = 0; b < nb; ++b) {
+      if (base_on_) {  // Ys is the residual's projection then: the base's bone rotation
+        Rb[b] = Mt.R[b];
+        continue;
+      }
       const Eigen::Matrix3d JT = DmidVS_.middleRows(3 * b, 3) * Ys;
       Rb[b] = polar_decomposition(JT.transpose()).R;
     }
@@ -560,6 +579,9 @@ RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) cons
     };
     const Eigen::MatrixXd Pa = src_nodes_.positions(Xs, src_F_);
     W_graph = Gsp_pos_ * Pa + Gsp_corr_ * rotated(sp_corr_, sp_bone_) + Gvol_ * rotated(vol_delta_, vol_bone_);
+    if (base_on_)  // the maps carry what the base leaves of both graphs' Laplacian coordinates
+      W_graph -= Gsp_corr_ * (Lsp_ * apply_bone_motions(blend_Va_, Va_, Mt)) +
+                 Gvol_ * (Lvol_ * apply_bone_motions(blend_vol_, Xvol_, Mt));
     Jt_fixed += Kt_joints_ * W_graph;
   }
   Eigen::MatrixXd Jt_now = nb > 0 ? Eigen::MatrixXd(Jt_fixed + KtGb_ * (dirs - base_dirs)) : Jt_fixed;
@@ -586,7 +608,9 @@ RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) cons
   out.joints = (Jt_now * R_) * Lt_;
   out.joints.rowwise() += ct_;
   if (graph_on_) {
-    out.graph_nodes = ((KtVa_ * Wt) * R_) * Lt_;
+    Eigen::MatrixXd Gn = KtVa_ * Wt;
+    if (base_on_) Gn += apply_bone_motions(blend_Va_, Va_, Mt);
+    out.graph_nodes = (Gn * R_) * Lt_;
     out.graph_nodes.rowwise() += ct_;
   }
   out.source_joints = Js_now * Ls_;

@@ -91,8 +91,9 @@ struct HarmonicRetargetOptions {
   // anchor trajectory, and both surfaces follow them by distance-blended weights (bone_blend.h).
   // The MFS maps then carry only the residual — the fit's floor (0.011 of the height with 260
   // singularities on KayKit's rigid parts) no longer applies to the articulated motion. With
-  // the context graph on, the base is off (not combined yet; a warning says so). Every step is
-  // continuous in the input (weights, fits, correspondences), so native and wasm agree.
+  // the context graph, E_spatial and E_volume ask the maps for what the base leaves at the graph
+  // nodes. Every step is continuous in the input (weights, fits, correspondences), so native
+  // and wasm agree.
   bool articulated_base = true;
   double base_fit_weight = 0.3;     // a source vertex joins a bone's rigid fit from this weight on (weighed by w²)
   int base_frames = 16;             // source poses the job hands over for learning the weights (spread over all clips)
@@ -245,6 +246,9 @@ class HarmonicRetargeter {
   Eigen::VectorXi sp_bone_;             // #rows bone whose rotation turns sp_corr_ (-1: none)
   Eigen::MatrixXd Gsp_pos_, Gsp_corr_;  // N_a by #N, N_a by #rows
   Eigen::MatrixXd vol_delta_;           // #rows_v by 3 rest Laplacian coordinates of the volume graph
+  Eigen::SparseMatrix<double> Lvol_;    // #rows_v by #Nv volume-graph Laplacian rows
+  Eigen::MatrixXd Xvol_;                // #Nv by 3 volume-graph nodes (working)
+  BoneBlend blend_Va_, blend_vol_;      // articulated base at the target nodes and volume nodes
   Eigen::VectorXi vol_bone_;            // #rows_v
   Eigen::MatrixXd Gvol_;                // N_a by #rows_v
   Eigen::MatrixXd DmidVS_;              // 3·#bones by r: source Jacobians at bone midpoints from Ys
