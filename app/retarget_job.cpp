@@ -46,8 +46,8 @@ const OptionSchema<RetargetJobOptions>& retarget_options() {
            "joint whose (scaled) trajectory the target follows (\"\" = the shallowest)");
     s.choice<bool>("articulated_base", [](O& o) -> bool& { return o.harmonic.articulated_base; },
                    {{"on", true}, {"off", false}},
-                   "bones' motions learned from the clip carry the surfaces; the harmonic maps add the rest "
-                   "(off: the paper's maps alone)");
+                   "bones' motions (weights learned from all the source's clips) carry the surfaces; the harmonic "
+                   "maps add the rest (off: the paper's maps alone)");
     s.choice<bool>("context_graph", [](O& o) -> bool& { return o.harmonic.context_graph; },
                    {{"on", true}, {"off", false}},
                    "context graph terms E_spatial and E_volume (Sec. 6, Eq. 11-12)");
