@@ -18,7 +18,8 @@ RigidFit rigid_fit_centred(const Eigen::MatrixXd& P0, const Eigen::MatrixXd& Q0,
   bool optimal = false;  // R is the unconstrained optimum (closed-form s and residual apply)
   double tr = 0;         // tr(ΣD)
   if (P0.rows() >= 3) {
-    const Eigen::Matrix3d C = Q0.transpose() * P0;  // Σ w (q − q̄)(p − p̄)ᵀ
+    Eigen::Matrix3d C = Q0.transpose() * P0;  // Σ w (q − q̄)(p − p̄)ᵀ
+    if (opt.rotation_prior > 0) C += opt.rotation_prior * p2 * Eigen::Matrix3d::Identity();
     Eigen::JacobiSVD<Eigen::Matrix3d> svd(C, Eigen::ComputeFullU | Eigen::ComputeFullV);
     const Eigen::Vector3d sv = svd.singularValues();
     if (opt.min_spread < 0 || sv[1] > opt.min_spread * sv[0]) {

@@ -17,6 +17,9 @@ struct RigidFitOptions {
   // No rotation can be read off (degenerate) when there are fewer than 3 points or when
   // σ₂ ≤ min_spread·σ₁ (collinear points). Negative: only the point count is checked.
   double min_spread = -1;
+  // Adds this × Σw|p̃|² × I to the cross-covariance: a pull towards no rotation that decides the
+  // rotation about a degenerate axis (thin or flat point sets) instead of rounding noise. 0 = off.
+  double rotation_prior = 0;
 };
 
 struct RigidFit {

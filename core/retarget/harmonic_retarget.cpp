@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include <Eigen/Geometry>
-#include <Eigen/SVD>
 
 #include "linalg/polar.h"
 #include "linalg/rigid_fit.h"
@@ -411,23 +410,16 @@ BoneMotions HarmonicRetargeter::source_bone_motions(const Eigen::MatrixXd& Xs) c
       Q.row(k) = Xs.row(set[k]);
       w[k] = base_fit_w_[b][k];
     }
-    // Weighted Kabsch with a small pull towards no rotation (1e-3 of the set's spread added to
-    // the cross-covariance): a thin or flat set (an ear, a tail tip) leaves a rotation about its
-    // degenerate axis undetermined, and a plain SVD then picks it from rounding noise.
-    const double ws = w.sum();
-    if (!(ws > 0)) continue;
-    const Eigen::RowVector3d pc = (w.transpose() * P) / ws, qc = (w.transpose() * Q) / ws;
-    const Eigen::MatrixXd Pc = P.rowwise() - pc, Qc = Q.rowwise() - qc;
-    Eigen::Matrix3d H = Pc.transpose() * w.asDiagonal() * Qc;
-    const double spread = (Pc.transpose() * w.asDiagonal() * Pc).trace();
-    H += 1e-3 * spread * Eigen::Matrix3d::Identity();
-    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
-    D(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
-    const Eigen::Matrix3d R = svd.matrixV() * D * svd.matrixU().transpose();
-    if (!R.allFinite()) continue;
-    M.R[b] = R;
-    M.t.row(b) = qc - (R * pc.transpose()).transpose();
+    // A small pull towards no rotation (1e-3 of the set's spread): a thin or flat set (an ear, a
+    // tail tip) leaves a rotation about its degenerate axis undetermined, and a plain SVD then
+    // picks it from rounding noise.
+    if (!(w.sum() > 0)) continue;
+    RigidFitOptions fo;
+    fo.rotation_prior = 1e-3;
+    const RigidFit f = fit_rigid(P, Q, w, fo);
+    if (f.degenerate || !f.R.allFinite()) continue;
+    M.R[b] = f.R;
+    M.t.row(b) = f.t.transpose();
     fitted[b] = 1;
   }
   // Bones without a fit (too few or collinear vertices): the motion of the parent's bone.
