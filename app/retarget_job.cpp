@@ -46,8 +46,11 @@ const OptionSchema<RetargetJobOptions>& retarget_options() {
            "joint whose (scaled) trajectory the target follows (\"\" = the shallowest)");
     s.choice<bool>("articulated_base", [](O& o) -> bool& { return o.harmonic.articulated_base; },
                    {{"on", true}, {"off", false}},
-                   "bones' motions (weights learned from all the source's clips) carry the surfaces; the harmonic "
+                   "bones' motions (fitted on the source each frame) carry the surfaces; the harmonic "
                    "maps add the rest (off: the paper's maps alone)");
+    s.choice<bool>("base_weights", [](O& o) -> bool& { return o.harmonic.base_skin_weights; },
+                   {{"skin", true}, {"learned", false}},
+                   "the articulated base's bone weights: the source's own skin, or learned from poses over all its clips");
     s.choice<bool>("context_graph", [](O& o) -> bool& { return o.harmonic.context_graph; },
                    {{"on", true}, {"off", false}},
                    "context graph terms E_spatial and E_volume (Sec. 6, Eq. 11-12)");
@@ -145,7 +148,7 @@ Status RetargetJob::prepare(const io::Asset& source, const io::Asset& target, co
     map = std::move(mr.source_to_target);
   }
   const JointSet source_joints = character_joints(source_);
-  RetargetCharacter S{source_.V_rest, source_.F, source_joints};
+  RetargetCharacter S{source_.V_rest, source_.F, source_joints, joint_skin_weights(source_, source_joints)};
   RetargetCharacter T{target_V_, target_F_, target_joints};
   // Multi-part characters interpenetrate at rest by design: per-frame counts leave those pairs out.
   rest_intersections_ = intersecting_triangle_pairs(target_V_, target_F_);
@@ -156,11 +159,13 @@ Status RetargetJob::prepare(const io::Asset& source, const io::Asset& target, co
       for (int i = 0; i < k; ++i) gf.push_back(source_frame(k > 1 ? i * (nf - 1) / (k - 1) : 0));
     }
     harmonic_.set_graph_frames(std::move(gf));
-    // The articulated base learns the source's bone weights from poses spread evenly over all of
-    // its clips end to end (not only the chosen one): the weights, and so every clip's result,
-    // do not depend on which clip was prepared (the batch worker reuses one preparation).
+    // With base_weights "learned" the articulated base learns the source's bone weights from poses
+    // spread evenly over all of its clips end to end (not only the chosen one): the weights, and
+    // so every clip's result, do not depend on which clip was prepared (the batch worker reuses
+    // one preparation). By default they come from the source's own skin.
     std::vector<Eigen::MatrixXd> bf;
-    if (opt.harmonic.articulated_base && opt.harmonic.base_frames > 0 && !source_.clips.empty()) {
+    if (opt.harmonic.articulated_base && !opt.harmonic.base_skin_weights && opt.harmonic.base_frames > 0 &&
+        !source_.clips.empty()) {
       double total = 0;
       for (const AnimationClip& c : source_.clips) total += std::max(0.0, c.end - c.start);
       const int k = opt.harmonic.base_frames;

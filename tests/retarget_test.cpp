@@ -290,8 +290,8 @@ TEST(RetargetReal, SelfRetargetingCesiumMan) {
   RecordProperty("mean_error_over_height", std::to_string(e.mean));
   RecordProperty("max_frame_error_over_height", std::to_string(e.max));
   std::cout << "[ CesiumMan self-retargeting ] mean " << e.mean << " max frame " << e.max << " of height\n";
-  // Issue 15: stays <= 0.005. Measured 0.0011 with the articulated base (the default), 0.0042
-  // with the paper's maps alone.
+  // Issue 15: stays <= 0.005. Measured 0.00079 with the articulated base on the source's skin
+  // weights (the default), 0.0011 with learned weights, 0.0042 with the paper's maps alone.
   EXPECT_LE(e.mean, 0.005);
 }
 
@@ -315,8 +315,8 @@ TEST(RetargetReal, SelfRetargetingKayKitKnight) {
   const mm::SequenceError e = self_error(*j);
   RecordProperty("mean_error_over_height", std::to_string(e.mean));
   std::cout << "[ Knight self-retargeting, articulated base ] mean " << e.mean << " max frame " << e.max << " of height\n";
-  // Issue 15: <= 0.006. Measured 0.0039 with the articulated base: the bones' motions carry the
-  // six rigid parts and the map only the rest.
+  // Issue 15: <= 0.006. Measured 0.0016 with the articulated base on the skin's weights (0.0039
+  // with learned weights): the bones' motions carry the six rigid parts and the map the rest.
   EXPECT_LE(e.mean, 0.006);
   // The paper's maps alone: with 260 singularities the MFS fit (Eq. 13) of the six parts is 0.011
   // of the height (0.014 measured); regression guard.
@@ -350,15 +350,16 @@ TEST(RetargetReal, SelfRetargetingKayKitBarbarian) {
   const mm::SequenceError e = self_error(*j);
   RecordProperty("mean_error_over_height", std::to_string(e.mean));
   std::cout << "[ Barbarian self-retargeting ] mean " << e.mean << " max frame " << e.max << " of height\n";
-  // Issue 15: <= 0.006. Measured 0.0049 with the articulated base (0.013 with the paper's maps).
+  // Issue 15: <= 0.006. Measured 0.0021 with the articulated base (0.0049 with learned weights,
+  // 0.013 with the paper's maps).
   EXPECT_LE(e.mean, 0.006);
 }
 
 TEST(RetargetReal, KnightToBarbarianHarmonicVsLbs) {
   // Issue 15: <= 0.008 of the height against Barbarian's own clip, on Walking_A and an arm-heavy
-  // clip. Measured with the articulated base (weights learned from 16 poses over all of the
-  // Knight's clips) / the paper's maps alone / LBS: Walking_A 0.0075 / 0.0219 / 0.0031, Cheer
-  // 0.0074 / 0.0154 / 0.0030.
+  // clip. Measured with the articulated base on the Knight's skin weights / on weights learned
+  // from 16 poses over all of the Knight's clips / the paper's maps alone / LBS: Walking_A 0.0044 /
+  // 0.0075 / 0.0219 / 0.0031, Cheer 0.0048 / 0.0074 / 0.0154 / 0.0030.
   for (const char* clip_name : {"Walking_A", "Cheer"}) {
   auto h = job("anim/KayKit/Knight.glb", "anim/KayKit/Barbarian.glb", clip_name, 10, -1, "",
                mm::app::RetargetMethod::Harmonic, base_on);
@@ -383,6 +384,17 @@ TEST(RetargetReal, KnightToBarbarianHarmonicVsLbs) {
   EXPECT_LE(eh.mean, 0.008) << clip_name;
   EXPECT_LE(eh.mean, 3 * el.mean) << clip_name;  // same rig: within 3x of the LBS baseline
   EXPECT_LT(el.mean, 0.05) << clip_name;
+  // The base's weights learned from poses instead of the skin (a source whose skin does not
+  // describe its motion, e.g. baked simulation): still within the issue's bound.
+  auto learned = job("anim/KayKit/Knight.glb", "anim/KayKit/Barbarian.glb", clip_name, 10, -1, "",
+                     mm::app::RetargetMethod::Harmonic, [](mm::HarmonicRetargetOptions& o) { o.base_skin_weights = false; });
+  ASSERT_TRUE(learned->status.ok()) << learned->status.message;
+  std::vector<Eigen::MatrixXd> vw;
+  ASSERT_TRUE(learned->session.frames(0, learned->session.num_frames(), &vw).ok());
+  const mm::SequenceError ew = mm::sequence_vertex_error(vw, gt, H);
+  std::cout << "[ Knight -> Barbarian vs Barbarian's own " << clip_name << ", learned base weights ] " << ew.mean << "\n";
+  EXPECT_LE(ew.mean, 0.008) << clip_name;
+  EXPECT_LT(eh.mean, ew.mean) << clip_name;  // the skin's weights are the better start
   }
 }
 
@@ -405,8 +417,8 @@ TEST(RetargetReal, FoxToWolfWithPlacedJoints) {
   RecordProperty("bone_length_error_mean", std::to_string(be.mean));
   RecordProperty("bone_length_error_max", std::to_string(be.max));
   std::cout << "[ Fox -> wolf0 ] bone-length error mean " << be.mean << " max " << be.max << "\n";
-  // Issue 15: not worse than the paper's maps alone (mean 0.029). Measured 0.016 with the
-  // articulated base.
+  // Issue 15: not worse than the paper's maps alone (mean 0.029). Measured 0.0097 with the
+  // articulated base on the Fox's skin weights, 0.016 with learned weights.
   EXPECT_LE(be.mean, 0.029);
   EXPECT_LT(be.max, 0.3);
 }
@@ -418,8 +430,11 @@ TEST(RetargetReal, MultiPartRobotExpressive) {
   EXPECT_EQ(j->session.source_character().parts.size(), 19u);
   const mm::SequenceError e = self_error(*j);
   std::cout << "[ RobotExpressive self-retargeting ] mean " << e.mean << " of height\n";
-  EXPECT_TRUE(std::isfinite(e.mean));
-  EXPECT_LT(e.mean, 0.015);
+  // Issue 15: <= 0.006. Its rig hangs the torso mesh under Body (not the spine), the feet under
+  // an IK root outside the mesh and animates the face by morph targets: the base takes each
+  // part's bone from the skin (leaf joints get bones of their own) and the maps carry the morphs.
+  // Measured 2.7e-5 (0.0098 with learned weights and no leaf bones, 0.011 with the maps alone).
+  EXPECT_LE(e.mean, 0.006);
 }
 
 TEST(RetargetReal, PropsFollowTheirJointsInTheExportedGlb) {
@@ -544,7 +559,7 @@ TEST(RetargetReal, ArticulatedBaseIsContinuousInItsInput) {
     poses.push_back(mm::pose_at(s.character, clip, c.start + u * (c.end - c.start)));
   }
   const double h = height(t.character.V_rest);
-  auto run = [&](double eps) {
+  auto run = [&](double eps, bool skin) {
     // Each vertex (source rest and poses, target rest) moved by eps·h in a direction of its own
     // (a scaling would be undone exactly by the working frames).
     auto nudge = [&](Eigen::MatrixXd V) {
@@ -552,7 +567,9 @@ TEST(RetargetReal, ArticulatedBaseIsContinuousInItsInput) {
         V.row(i) += eps * h * Eigen::RowVector3d(std::sin(1.3 * i), std::cos(2.1 * i), std::sin(0.7 * i + 1));
       return V;
     };
-    const mm::RetargetCharacter S{nudge(s.character.V_rest), s.character.F, mm::character_joints(s.character)};
+    const mm::JointSet J = mm::character_joints(s.character);
+    const mm::RetargetCharacter S{nudge(s.character.V_rest), s.character.F, J,
+                                  skin ? mm::joint_skin_weights(s.character, J) : mm::SkinWeights{}};
     const mm::RetargetCharacter T{nudge(t.character.V_rest), t.character.F, mm::character_joints(t.character)};
     std::vector<Eigen::MatrixXd> frames;
     for (const auto& P : poses) frames.push_back(nudge(P));
@@ -565,10 +582,13 @@ TEST(RetargetReal, ArticulatedBaseIsContinuousInItsInput) {
     for (const auto& P : frames) out.push_back(H.retarget(P).V);
     return out;
   };
-  const auto a = run(0), b = run(1e-13);
-  double worst = 0;
-  for (size_t k = 0; k < a.size(); ++k) worst = std::max(worst, (a[k] - b[k]).rowwise().norm().maxCoeff() / h);
-  std::cout << "[ articulated base, 1e-13 input change ] largest output change " << worst << " of the height\n";
-  EXPECT_LT(worst, 1e-3);
+  for (bool skin : {true, false}) {
+    const auto a = run(0, skin), b = run(1e-13, skin);
+    double worst = 0;
+    for (size_t k = 0; k < a.size(); ++k) worst = std::max(worst, (a[k] - b[k]).rowwise().norm().maxCoeff() / h);
+    std::cout << "[ articulated base, " << (skin ? "skin" : "learned") << " weights, 1e-13 input change ] largest output change "
+              << worst << " of the height\n";
+    EXPECT_LT(worst, 1e-3);
+  }
 }
 

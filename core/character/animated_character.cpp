@@ -179,6 +179,31 @@ SkinWeights character_skin_weights(const AnimatedCharacter& c) {
   return W;
 }
 
+SkinWeights joint_skin_weights(const AnimatedCharacter& c, const JointSet& J) {
+  SkinWeights W = character_skin_weights(c);
+  std::map<std::string, int> row_of;
+  for (int j = 0; j < J.size(); ++j) row_of[J.names[j]] = j;
+  const int n = static_cast<int>(c.node_names.size());
+  std::vector<int> joint_of(n, -1);
+  for (int i = 0; i < n; ++i) {
+    int a = i;
+    for (int guard = 0; a >= 0 && guard <= n; ++guard) {
+      const auto it = row_of.find(c.node_names[a]);
+      if (it != row_of.end()) {
+        joint_of[i] = it->second;
+        break;
+      }
+      a = c.node_parent[a];
+    }
+  }
+  for (Eigen::Index v = 0; v < W.index.rows(); ++v)
+    for (Eigen::Index k = 0; k < W.index.cols(); ++k) {
+      const int node = W.index(v, k);
+      W.index(v, k) = node >= 0 && node < n ? joint_of[node] : -1;
+    }
+  return W;
+}
+
 Matrix4dList node_motions(const AnimatedCharacter& c, const Matrix4dList& world) {
   const Matrix4dList rest = node_world_matrices(c, -1, 0);
   Matrix4dList M(world.size());

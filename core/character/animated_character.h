@@ -96,6 +96,10 @@ JointSet character_joints(const AnimatedCharacter& c);
 // weight = skin weight (rigid parts: their node, weight 1). Together with node_motions, LBS of
 // V_rest reproduces posed_vertices.
 SkinWeights character_skin_weights(const AnimatedCharacter& c);
+// The same influences over the rows of J (a character_joints set): each node's weight goes to
+// its nearest ancestor (itself included) among J's joints, matched by node name; weights on
+// nodes without one get index -1.
+SkinWeights joint_skin_weights(const AnimatedCharacter& c, const JointSet& J);
 // Per node: world(t) · world(rest)⁻¹ (maps the rest surface to the posed one).
 Matrix4dList node_motions(const AnimatedCharacter& c, const Matrix4dList& world);
 

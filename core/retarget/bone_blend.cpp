@@ -160,6 +160,74 @@ BoneBlend learn_bone_weights(const Eigen::MatrixXd& X, const std::vector<Eigen::
   return out;
 }
 
+namespace {
+
+// Distance from x to the segment from J(bone.second) to J(bone.first).
+double segment_distance(const Eigen::Vector3d& x, const Eigen::MatrixXd& J, const std::pair<int, int>& bone) {
+  const Eigen::Vector3d a = J.row(bone.second).transpose(), ab = J.row(bone.first).transpose() - a;
+  const double L2 = ab.squaredNorm();
+  const double s = L2 > 0 ? std::clamp((x - a).dot(ab) / L2, 0.0, 1.0) : 0.0;
+  return (x - a - s * ab).norm();
+}
+
+// Appends a row from (weight, bone) pairs: merged per bone, the kMaxBones largest kept minus the
+// next one (no jump at the cut), normalised.
+void push_row(std::vector<std::pair<double, int>>& acc, BoneBlend* out) {
+  std::sort(acc.begin(), acc.end(), [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+  const double cut = acc.size() > BoneBlend::kMaxBones ? std::max(0.0, acc[BoneBlend::kMaxBones].first) : 0.0;
+  if (acc.size() > BoneBlend::kMaxBones) acc.resize(BoneBlend::kMaxBones);
+  double sum = 0;
+  for (const auto& e : acc) sum += std::max(0.0, e.first - cut);
+  for (const auto& e : acc)
+    if (e.first - cut > 0 && sum > 0) out->bone.push_back(e.second), out->w.push_back((e.first - cut) / sum);
+  out->ptr.push_back(static_cast<int>(out->bone.size()));
+}
+
+void accumulate(std::vector<std::pair<double, int>>& acc, int bone, double w) {
+  auto it = std::find_if(acc.begin(), acc.end(), [&](const auto& e) { return e.second == bone; });
+  if (it == acc.end()) acc.push_back({w, bone});
+  else it->first += w;
+}
+
+}  // namespace
+
+BoneBlend skin_blend(const Eigen::MatrixXd& P, const Eigen::MatrixXi& index, const Eigen::MatrixXd& weight,
+                     const std::vector<std::vector<int>>& drives, const Eigen::MatrixXd& J,
+                     const std::vector<std::pair<int, int>>& bones, const BoneBlend& fallback) {
+  BoneBlend out;
+  std::vector<std::pair<double, int>> acc;
+  for (Eigen::Index i = 0; i < P.rows(); ++i) {
+    acc.clear();
+    const Eigen::Vector3d x = P.row(i).transpose();
+    double kept = 0, total = 0;
+    for (Eigen::Index k = 0; k < index.cols(); ++k) {
+      const int j = index(i, k);
+      const double w = weight(i, k);
+      if (!(w > 0)) continue;
+      total += w;
+      if (j < 0 || j >= static_cast<int>(drives.size()) || drives[j].empty()) continue;
+      kept += w;
+      // Split among the joint's bones by 1/d⁴ (a tiny floor keeps points on a segment finite).
+      const double floor = 1e-9 * (1.0 + x.norm());
+      double norm = 0;
+      std::vector<double> raw;
+      for (int b : drives[j]) {
+        const double d = std::max(segment_distance(x, J, bones[b]), floor);
+        raw.push_back(std::pow(d, -4.0));
+        norm += raw.back();
+      }
+      for (size_t a = 0; a < raw.size(); ++a) accumulate(acc, drives[j][a], w * raw[a] / norm);
+    }
+    if (!(total > 0) || kept < 0.5 * total) {
+      acc.clear();
+      if (i < fallback.rows())
+        for (int k = fallback.ptr[i]; k < fallback.ptr[i + 1]; ++k) acc.push_back({fallback.w[k], fallback.bone[k]});
+    }
+    push_row(acc, &out);
+  }
+  return out;
+}
+
 BoneBlend interpolate_blend(const BoneBlend& W, const Eigen::MatrixXi& F, const Eigen::VectorXi& face,
                             const Eigen::MatrixXd& bary, const BoneBlend* fallback) {
   BoneBlend out;
@@ -169,25 +237,12 @@ BoneBlend interpolate_blend(const BoneBlend& W, const Eigen::MatrixXi& F, const 
     if (face[i] >= 0) {
       for (int c = 0; c < 3; ++c) {
         const int v = F(face[i], c);
-        for (int k = W.ptr[v]; k < W.ptr[v + 1]; ++k) {
-          const double add = bary(i, c) * W.w[k];
-          auto it = std::find_if(acc.begin(), acc.end(), [&](const auto& e) { return e.second == W.bone[k]; });
-          if (it == acc.end()) acc.push_back({add, W.bone[k]});
-          else it->first += add;
-        }
+        for (int k = W.ptr[v]; k < W.ptr[v + 1]; ++k) accumulate(acc, W.bone[k], bary(i, c) * W.w[k]);
       }
     } else if (fallback) {
       for (int k = fallback->ptr[i]; k < fallback->ptr[i + 1]; ++k) acc.push_back({fallback->w[k], fallback->bone[k]});
     }
-    std::sort(acc.begin(), acc.end(), [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
-    // Beyond kMaxBones the next weight is subtracted from the kept ones (no jump at the cut).
-    const double cut = acc.size() > BoneBlend::kMaxBones ? std::max(0.0, acc[BoneBlend::kMaxBones].first) : 0.0;
-    if (acc.size() > BoneBlend::kMaxBones) acc.resize(BoneBlend::kMaxBones);
-    double sum = 0;
-    for (const auto& e : acc) sum += std::max(0.0, e.first - cut);
-    for (const auto& e : acc)
-      if (e.first - cut > 0 && sum > 0) out.bone.push_back(e.second), out.w.push_back((e.first - cut) / sum);
-    out.ptr.push_back(static_cast<int>(out.bone.size()));
+    push_row(acc, &out);
   }
   return out;
 }

@@ -55,6 +55,15 @@ BoneBlend learn_bone_weights(const Eigen::MatrixXd& X, const std::vector<Eigen::
 BoneBlend interpolate_blend(const BoneBlend& W, const Eigen::MatrixXi& F, const Eigen::VectorXi& face,
                             const Eigen::MatrixXd& bary, const BoneBlend* fallback = nullptr);
 
+// Weights from a skin: point i's weight weight(i, k) on skin joint index(i, k) goes to the bones
+// that joint drives (drives[joint]: bone indices; empty = the weight is dropped), split among them
+// by the inverse fourth power of the point's distance to their segments (continuous in the point).
+// Beyond kMaxBones the next weight is subtracted from the kept ones. Rows that keep less than half
+// of their weight take the row of `fallback`.
+BoneBlend skin_blend(const Eigen::MatrixXd& P, const Eigen::MatrixXi& index, const Eigen::MatrixXd& weight,
+                     const std::vector<std::vector<int>>& drives, const Eigen::MatrixXd& J,
+                     const std::vector<std::pair<int, int>>& bones, const BoneBlend& fallback);
+
 // A start for templates far from the target's pose (e.g. a rest pose onto a walk frame, where
 // closest points pull a swung arm onto the body and the stiff first ICP steps never let go): each
 // bone turns by the smallest rotation taking J0(child) − J0(parent) onto J1(child) − J1(parent)

@@ -241,8 +241,14 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
   if (base_on_) {
     Xs_rest_ = Xs;
     Xt_rest_ = Xt;
-    const int nb = static_cast<int>(bones_.size());
-    BoneBlend bv = bone_blend(Xs, Js_rest_, bones_);
+    const SkinWeights& skin = source.skin;
+    const bool use_skin = opt.base_skin_weights && skin.index.rows() == Xs.rows() && skin.weight.rows() == Xs.rows() &&
+                          skin.index.cols() == skin.weight.cols() && skin.index.cols() > 0 && skin.weight.allFinite();
+    // Leaf bones only with the skin: learned weights spread worse over the extra candidates
+    // (Knight → Barbarian 0.0075 → 0.0094 of the height with them).
+    build_base_skeleton(Xs, use_skin);
+    const int nb = static_cast<int>(base_bones_.size());
+    BoneBlend bv = bone_blend(Xs, base_Js_rest_, base_bones_);
     // Each bone's rigid fit: the source vertices it has a weight w > base_fit_weight in, weighed
     // by ((w − τ)/(1 − τ))² (continuous in w: no vertex enters or leaves a fit abruptly); a bone
     // without such vertices takes every vertex it has a share of, weighed by w².
@@ -277,14 +283,30 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
       if (Vf.rows() == Xs.rows() && Vf.cols() == 3 && Vf.allFinite())
         samples.push_back(to_working(Vf, cs_, Ls_, Eigen::Matrix3d::Identity()));
     bool learned = false;
-    if (!samples.empty()) {
+    if (use_skin) {
+      // The source's own skin: each joint's weight goes to the base bones its nearest used
+      // ancestor drives (the bones leaving it, its leaf bone).
+      const int nj = source.joints.size();
+      std::vector<std::vector<int>> drives(nj);
+      for (int j = 0; j < nj; ++j) {
+        int u = j;
+        for (int guard = 0; u >= 0 && used_of[u] < 0 && guard <= nj; ++guard)
+          u = has_tree ? source.joints.parent[u] : -1;
+        if (u < 0 || used_of[u] < 0) continue;
+        for (int b = 0; b < nb; ++b)
+          if (base_bones_[b].second == used_of[u]) drives[j].push_back(b);
+      }
+      bv = skin_blend(Xs, skin.index, skin.weight, drives, base_Js_rest_, base_bones_, bv);
+      fit_sets(bv);
+      learned = true;
+    } else if (!samples.empty()) {
+      const BoneBlend candidates = bone_blend(Xs, base_Js_rest_, base_bones_, 3.0);
       std::vector<BoneMotions> motions;
       for (const Eigen::MatrixXd& Xf : samples) {
         Eigen::MatrixXd Jb;
         std::vector<Eigen::Matrix3d> Rf;
         motions.push_back(source_base(Xf, &Jb, &Rf));
       }
-      const BoneBlend candidates = bone_blend(Xs, Js_rest_, bones_, 3.0);
       bv = learn_bone_weights(Xs, samples, motions, candidates);
       fit_sets(bv);
       learned = true;
@@ -298,7 +320,7 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
       // source point. (Bone coordinates by rays, as the surface descriptors use, gave the same
       // accuracy but jumped between builds: a ray's last-bit crossing decision moved a vertex's
       // weights wholesale.)
-      const Eigen::MatrixXd Xts = articulated_points(Xt, Jt_rest_, Js_rest_, bones_);
+      const Eigen::MatrixXd Xts = articulated_points(Xt, base_Jt_rest_, base_Js_rest_, base_bones_);
       Eigen::VectorXi face(Xt.rows());
       Eigen::MatrixXd bary(Xt.rows(), 3);
       for (Eigen::Index i = 0; i < Xt.rows(); ++i) {
@@ -306,11 +328,11 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
         face[i] = cp.face;
         bary.row(i) = cp.barycentric.transpose();
       }
-      const BoneBlend fallback = bone_blend(Xt, Jt_rest_, bones_);
+      const BoneBlend fallback = bone_blend(Xt, base_Jt_rest_, base_bones_);
       blend_verts_t_ = interpolate_blend(bv, source.F, face, bary, &fallback);
     } else {
-      blend_colloc_s_ = bone_blend(colloc_rest_s_, Js_rest_, bones_);
-      blend_verts_t_ = bone_blend(Xt, Jt_rest_, bones_);
+      blend_colloc_s_ = bone_blend(colloc_rest_s_, base_Js_rest_, base_bones_);
+      blend_verts_t_ = bone_blend(Xt, base_Jt_rest_, base_bones_);
     }
     if (graph_on_) {
       // The base at the graph's target nodes (on the surface: the vertices' weights there) and
@@ -318,7 +340,7 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
       blend_Va_ = interpolate_blend(blend_verts_t_, target.F, graph_.target_face, graph_.target_barycentric);
       const SurfaceSamples& C = tgt_map_.collocation();
       const int ns = graph_.volume_surface, nv = static_cast<int>(Xvol_.rows());
-      const BoneBlend inner = bone_blend(Xvol_.bottomRows(nv - ns), Jt_rest_, bones_);
+      const BoneBlend inner = bone_blend(Xvol_.bottomRows(nv - ns), base_Jt_rest_, base_bones_);
       const BoneBlend surf = interpolate_blend(blend_verts_t_, target.F, C.face.head(ns), C.barycentric.topRows(ns));
       blend_vol_ = surf;
       for (int i = 0; i < inner.rows(); ++i) {
@@ -329,16 +351,17 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
         blend_vol_.ptr.push_back(static_cast<int>(blend_vol_.bone.size()));
       }
     }
-    // Forward-kinematics order: from each root down (bones_ are (child, parent) joint pairs).
-    std::vector<std::vector<int>> child_bones(m);
-    std::vector<char> is_child(m, 0);
+    // Forward-kinematics order: from each root down (base bones are (child, parent) joint pairs).
+    const int mb = static_cast<int>(base_Js_rest_.rows());
+    std::vector<std::vector<int>> child_bones(mb);
+    std::vector<char> is_child(mb, 0);
     for (int b = 0; b < nb; ++b) {
-      child_bones[bones_[b].second].push_back(b);
-      is_child[bones_[b].first] = 1;
+      child_bones[base_bones_[b].second].push_back(b);
+      is_child[base_bones_[b].first] = 1;
     }
     fk_bones_.clear();
-    joint_root_.assign(m, -1);
-    for (int r = 0; r < m; ++r) {
+    joint_root_.assign(mb, -1);
+    for (int r = 0; r < mb; ++r) {
       if (is_child[r]) continue;
       joint_root_[r] = r;
       std::vector<int> stack{r};
@@ -347,8 +370,8 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
         stack.pop_back();
         for (int b : child_bones[j]) {
           fk_bones_.push_back(b);
-          joint_root_[bones_[b].first] = r;
-          stack.push_back(bones_[b].first);
+          joint_root_[base_bones_[b].first] = r;
+          stack.push_back(base_bones_[b].first);
         }
       }
     }
@@ -394,8 +417,66 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
   return Status::success();
 }
 
+void HarmonicRetargeter::build_base_skeleton(const Eigen::MatrixXd& Xs, bool leaf_bones) {
+  // The base's bones: the used bones, then one leaf bone per used joint that no bone leaves. A
+  // leaf joint's own motion (a head, a hand, a lower leg whose foot hangs under an IK root, a
+  // rigid part parented to that node) moves no used bone, so without a leaf bone the vertices it
+  // carries follow the parent bone. Its segment runs from the joint to a tip: half the parent
+  // bone further on, or (a joint without bones at all) towards the mean of the source vertices
+  // nearest to it. The tips are base joints of their own (rows after the used joints).
+  const int m = static_cast<int>(Js_rest_.rows());
+  base_bones_ = bones_;
+  base_Js_rest_ = Js_rest_;
+  base_Jt_rest_ = Jt_rest_;
+  if (!leaf_bones) return;
+  std::vector<int> parent_bone(m, -1), child_count(m, 0);
+  for (size_t b = 0; b < bones_.size(); ++b) {
+    parent_bone[bones_[b].first] = static_cast<int>(b);
+    ++child_count[bones_[b].second];
+  }
+  std::vector<Eigen::RowVector3d> tips_s, tips_t;
+  Eigen::MatrixXd near_sum = Eigen::MatrixXd::Zero(m, 3);
+  Eigen::VectorXi near_count = Eigen::VectorXi::Zero(m);
+  double mean_len = 0;
+  for (const auto& [c, p] : bones_) mean_len += (Js_rest_.row(c) - Js_rest_.row(p)).norm();
+  mean_len /= std::max<size_t>(1, bones_.size());
+  for (Eigen::Index i = 0; i < Xs.rows(); ++i) {
+    Eigen::Index j = 0;
+    (Js_rest_.rowwise() - Xs.row(i)).rowwise().squaredNorm().minCoeff(&j);
+    near_sum.row(j) += Xs.row(i);
+    ++near_count[j];
+  }
+  for (int j = 0; j < m; ++j) {
+    if (child_count[j] > 0) continue;
+    Eigen::RowVector3d ds, dt;
+    if (parent_bone[j] >= 0) {
+      const int p = bones_[parent_bone[j]].second;
+      ds = 0.5 * (Js_rest_.row(j) - Js_rest_.row(p));
+      dt = 0.5 * (Jt_rest_.row(j) - Jt_rest_.row(p));
+    } else {
+      if (near_count[j] == 0) continue;
+      const Eigen::RowVector3d u = near_sum.row(j) / near_count[j] - Js_rest_.row(j);
+      if (!(u.norm() > 1e-9)) continue;
+      ds = 0.5 * mean_len * u.normalized();
+      dt = scale_ * ds;
+    }
+    if (!(ds.norm() > 1e-9) || !(dt.norm() > 1e-9)) continue;
+    base_bones_.push_back({m + static_cast<int>(tips_s.size()), j});
+    tips_s.push_back(Js_rest_.row(j) + ds);
+    tips_t.push_back(Jt_rest_.row(j) + dt);
+  }
+  base_Js_rest_.resize(m + tips_s.size(), 3);
+  base_Jt_rest_.resize(m + tips_t.size(), 3);
+  base_Js_rest_.topRows(m) = Js_rest_;
+  base_Jt_rest_.topRows(m) = Jt_rest_;
+  for (size_t k = 0; k < tips_s.size(); ++k) {
+    base_Js_rest_.row(m + k) = tips_s[k];
+    base_Jt_rest_.row(m + k) = tips_t[k];
+  }
+}
+
 BoneMotions HarmonicRetargeter::source_bone_motions(const Eigen::MatrixXd& Xs) const {
-  const int nb = static_cast<int>(bones_.size());
+  const int nb = static_cast<int>(base_bones_.size());
   BoneMotions M;
   M.R.assign(nb, Eigen::Matrix3d::Identity());
   M.t = Eigen::MatrixXd::Zero(nb, 3);
@@ -426,7 +507,7 @@ BoneMotions HarmonicRetargeter::source_bone_motions(const Eigen::MatrixXd& Xs) c
   for (int b : fk_bones_) {
     if (fitted[b]) continue;
     for (int a : fk_bones_)
-      if (bones_[a].first == bones_[b].second && fitted[a]) {
+      if (base_bones_[a].first == base_bones_[b].second && fitted[a]) {
         M.R[b] = M.R[a];
         M.t.row(b) = M.t.row(a);
         fitted[b] = 1;
@@ -438,16 +519,16 @@ BoneMotions HarmonicRetargeter::source_bone_motions(const Eigen::MatrixXd& Xs) c
 
 BoneMotions HarmonicRetargeter::forward_kinematics(const std::vector<Eigen::Matrix3d>& R, const Eigen::MatrixXd& J_rest,
                                                    Eigen::MatrixXd* J) const {
-  const int nb = static_cast<int>(bones_.size());
+  const int nb = static_cast<int>(base_bones_.size());
   for (int b : fk_bones_) {
-    const auto [c, p] = bones_[b];
+    const auto [c, p] = base_bones_[b];
     J->row(c) = J->row(p) + (R[b] * (J_rest.row(c) - J_rest.row(p)).transpose()).transpose();
   }
   BoneMotions M;
   M.R = R;
   M.t.resize(nb, 3);
   for (int b = 0; b < nb; ++b) {
-    const int p = bones_[b].second;
+    const int p = base_bones_[b].second;
     M.t.row(b) = J->row(p) - (R[b] * J_rest.row(p).transpose()).transpose();
   }
   return M;
@@ -456,26 +537,27 @@ BoneMotions HarmonicRetargeter::forward_kinematics(const std::vector<Eigen::Matr
 BoneMotions HarmonicRetargeter::source_base(const Eigen::MatrixXd& Xs, Eigen::MatrixXd* Js_base,
                                             std::vector<Eigen::Matrix3d>* R) const {
   const BoneMotions Mk = source_bone_motions(Xs);
-  const int m = static_cast<int>(Js_rest_.rows()), nb = static_cast<int>(bones_.size());
+  const Eigen::MatrixXd& Jr = base_Js_rest_;
+  const int m = static_cast<int>(Jr.rows()), nb = static_cast<int>(base_bones_.size());
   Eigen::MatrixXd Jk = Eigen::MatrixXd::Zero(m, 3);
   Eigen::VectorXd count = Eigen::VectorXd::Zero(m);
   for (int b = 0; b < nb; ++b)
-    for (int j : {bones_[b].first, bones_[b].second}) {
-      Jk.row(j) += (Mk.R[b] * Js_rest_.row(j).transpose()).transpose() + Mk.t.row(b);
+    for (int j : {base_bones_[b].first, base_bones_[b].second}) {
+      Jk.row(j) += (Mk.R[b] * Jr.row(j).transpose()).transpose() + Mk.t.row(b);
       count[j] += 1;
     }
   for (int j = 0; j < m; ++j)
-    Jk.row(j) = count[j] > 0 ? Eigen::RowVector3d(Jk.row(j) / count[j]) : Eigen::RowVector3d(Js_rest_.row(j));
+    Jk.row(j) = count[j] > 0 ? Eigen::RowVector3d(Jk.row(j) / count[j]) : Eigen::RowVector3d(Jr.row(j));
   *R = Mk.R;
   for (int b = 0; b < nb; ++b) {
-    const auto [c, p] = bones_[b];
-    const Eigen::Vector3d s0 = Mk.R[b] * (Js_rest_.row(c) - Js_rest_.row(p)).transpose();
+    const auto [c, p] = base_bones_[b];
+    const Eigen::Vector3d s0 = Mk.R[b] * (Jr.row(c) - Jr.row(p)).transpose();
     const Eigen::Vector3d s1 = (Jk.row(c) - Jk.row(p)).transpose();
     if (s0.norm() > 1e-12 && s1.norm() > 1e-12)
       (*R)[b] = Eigen::Quaterniond::FromTwoVectors(s0, s1).toRotationMatrix() * Mk.R[b];
   }
   *Js_base = Jk;  // roots stay where the fits put them; FK fills the rest
-  return forward_kinematics(*R, Js_rest_, Js_base);
+  return forward_kinematics(*R, Jr, Js_base);
 }
 
 RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) const {
@@ -503,12 +585,14 @@ RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) cons
   if (base_on_) {
     std::vector<Eigen::Matrix3d> R;
     Ms = source_base(Xs, &Js_base, &R);
-    const int m = static_cast<int>(Js_rest_.rows());
+    const int mb = static_cast<int>(base_Js_rest_.rows());
     bs -= apply_bone_motions(blend_colloc_s_, colloc_rest_s_, Ms);
-    J_base = Jt_rest_;
-    for (int r = 0; r < m; ++r)
-      if (joint_root_[r] == r) J_base.row(r) = Jt_rest_.row(r) + scale_ * (Js_base.row(r) - Js_rest_.row(r));
-    Mt = forward_kinematics(R, Jt_rest_, &J_base);
+    J_base = base_Jt_rest_;
+    for (int r = 0; r < mb; ++r)
+      if (joint_root_[r] == r) J_base.row(r) = base_Jt_rest_.row(r) + scale_ * (Js_base.row(r) - base_Js_rest_.row(r));
+    Mt = forward_kinematics(R, base_Jt_rest_, &J_base);
+    Js_base.conservativeResize(Js_rest_.rows(), 3);  // the used joints (tips dropped)
+    J_base.conservativeResize(Jt_rest_.rows(), 3);
   }
   const Eigen::MatrixXd Ys = src_map_.project(bs);
   out.fit_residual = std::sqrt(std::max(0.0, bs.squaredNorm() - Ys.squaredNorm()) /

@@ -55,6 +55,7 @@
 #include "retarget/harmonic_synthesis.h"
 #include "retarget/nonrigid_icp.h"
 #include "character/joint_set.h"
+#include "character/skinning.h"
 
 namespace mm {
 
@@ -63,6 +64,10 @@ struct RetargetCharacter {
   Eigen::MatrixXd V;  // #V by 3 calibration surface (any triangle soup: parts, open, non-manifold)
   Eigen::MatrixXi F;  // #F by 3
   JointSet joints;    // calibration joints; the source's hierarchy (parent) defines the bones
+  // Optional skin of the surface over `joints` (#V by K indices into joints, weights; a glTF
+  // source's own skin, rigid parts at weight 1 on their joint). The articulated base then takes
+  // its bone weights from it instead of learning them from poses. Empty: learned / by distance.
+  SkinWeights skin;
 };
 
 struct HarmonicRetargetOptions {
@@ -88,13 +93,18 @@ struct HarmonicRetargetOptions {
   // Articulated base (not in the paper; docs/retarget.md "Articulated base"): each source frame's
   // bones get a rigid motion (least-squares fit of the source vertices each bone dominates), the
   // target's bones the same rotations by forward kinematics from its own rest joints and the
-  // anchor trajectory, and both surfaces follow them by distance-blended weights (bone_blend.h).
+  // anchor trajectory, and both surfaces follow them by per-vertex bone weights (the source's
+  // skin, or learned; carried to the target by the bone-posed closest point; bone_blend.h). Leaf
+  // joints get bones of their own (a head, a hand, a foot under an IK root).
   // The MFS maps then carry only the residual — the fit's floor (0.011 of the height with 260
   // singularities on KayKit's rigid parts) no longer applies to the articulated motion. With
   // the context graph, E_spatial and E_volume ask the maps for what the base leaves at the graph
   // nodes. Every step is continuous in the input (weights, fits, correspondences), so native
   // and wasm agree.
   bool articulated_base = true;
+  // The base's bone weights: from the source's own skin (RetargetCharacter::skin) when given and
+  // this is on; otherwise learned from the base frames (or by distance without them).
+  bool base_skin_weights = true;
   double base_fit_weight = 0.3;     // a source vertex joins a bone's rigid fit from this weight on (weighed by w²)
   int base_frames = 16;             // source poses the job hands over for learning the weights (spread over all clips)
 
@@ -190,6 +200,8 @@ class HarmonicRetargeter {
   // Articulated base: bone motions of a source frame (working frame), and the target joints they
   // give by forward kinematics (rows of used joints) with the target bones' motions.
   BoneMotions source_bone_motions(const Eigen::MatrixXd& Xs) const;
+  // base_bones_ (the used bones, plus leaf bones when asked) and their rest joints on both sides.
+  void build_base_skeleton(const Eigen::MatrixXd& Xs, bool leaf_bones);
   // The base's motions of a source frame: rigid fits, joints where they meet, bones turned onto
   // those joints (rotations R), FK from the roots (joints Js_base).
   BoneMotions source_base(const Eigen::MatrixXd& Xs, Eigen::MatrixXd* Js_base, std::vector<Eigen::Matrix3d>* R) const;
@@ -231,7 +243,9 @@ class HarmonicRetargeter {
   std::vector<std::vector<int>> base_fit_set_;         // per bone: source vertices of its rigid fit
   std::vector<std::vector<double>> base_fit_w_;        // and their weights in it
   BoneBlend blend_colloc_s_, blend_verts_t_;
-  std::vector<int> fk_bones_;                          // bones_ indices, parents before children
+  std::vector<std::pair<int, int>> base_bones_;       // bones_, then leaf bones (joint → tip)
+  Eigen::MatrixXd base_Js_rest_, base_Jt_rest_;       // used joints, then the leaf bones' tips (working)
+  std::vector<int> fk_bones_;                          // base_bones_ indices, parents before children
   std::vector<int> joint_root_;                        // per used joint: the root of its tree
   // Context graph (Sec. 6).
   std::vector<Eigen::MatrixXd> graph_frames_;
