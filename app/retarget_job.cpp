@@ -48,6 +48,9 @@ const OptionSchema<RetargetJobOptions>& retarget_options() {
                    {{"on", true}, {"off", false}},
                    "bones' motions (fitted on the source each frame) carry the surfaces; the harmonic "
                    "maps add the rest (off: the paper's maps alone)");
+    s.choice<bool>("target_weights", [](O& o) -> bool& { return o.harmonic.base_target_skin; },
+                   {{"skin", true}, {"transferred", false}},
+                   "the articulated base's weights on a rigged target: its own skin, or the source's carried over");
     s.choice<bool>("base_weights", [](O& o) -> bool& { return o.harmonic.base_skin_weights; },
                    {{"skin", true}, {"learned", false}},
                    "the articulated base's bone weights: the source's own skin, or learned from poses over all its clips");
@@ -149,7 +152,9 @@ Status RetargetJob::prepare(const io::Asset& source, const io::Asset& target, co
   }
   const JointSet source_joints = character_joints(source_);
   RetargetCharacter S{source_.V_rest, source_.F, source_joints, joint_skin_weights(source_, source_joints)};
-  RetargetCharacter T{target_V_, target_F_, target_joints};
+  // The target's own skin only with its own joints (auto or JSON joints treat it as unrigged).
+  const bool own_rig = target_is_gltf_ && target_joints_json.empty();
+  RetargetCharacter T{target_V_, target_F_, target_joints, own_rig ? joint_skin_weights(target_, target_joints) : SkinWeights{}};
   // Multi-part characters interpenetrate at rest by design: per-frame counts leave those pairs out.
   rest_intersections_ = intersecting_triangle_pairs(target_V_, target_F_);
   if (opt.method == RetargetMethod::Harmonic) {

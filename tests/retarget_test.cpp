@@ -357,9 +357,11 @@ TEST(RetargetReal, SelfRetargetingKayKitBarbarian) {
 
 TEST(RetargetReal, KnightToBarbarianHarmonicVsLbs) {
   // Issue 15: <= 0.008 of the height against Barbarian's own clip, on Walking_A and an arm-heavy
-  // clip. Measured with the articulated base on the Knight's skin weights / on weights learned
-  // from 16 poses over all of the Knight's clips / the paper's maps alone / LBS: Walking_A 0.0044 /
-  // 0.0075 / 0.0219 / 0.0031, Cheer 0.0048 / 0.0074 / 0.0154 / 0.0030.
+  // clip. Measured (Walking_A / Cheer): the articulated base with the Knight's skin weights and
+  // the Barbarian's own skin (the default for a rigged target) 0.0024 / 0.0034; the Barbarian
+  // treated as unrigged (the Knight's weights carried over) 0.0044 / 0.0048; weights learned from
+  // 16 poses over all of the Knight's clips, carried over 0.0075 / 0.0074; the paper's maps alone
+  // 0.0219 / 0.0154; LBS 0.0031 / 0.0030.
   for (const char* clip_name : {"Walking_A", "Cheer"}) {
   auto h = job("anim/KayKit/Knight.glb", "anim/KayKit/Barbarian.glb", clip_name, 10, -1, "",
                mm::app::RetargetMethod::Harmonic, base_on);
@@ -382,19 +384,29 @@ TEST(RetargetReal, KnightToBarbarianHarmonicVsLbs) {
   std::cout << "[ Knight -> Barbarian vs Barbarian's own " << clip_name << " ] harmonic " << eh.mean << ", LBS "
             << el.mean << " of height\n";
   EXPECT_LE(eh.mean, 0.008) << clip_name;
-  EXPECT_LE(eh.mean, 3 * el.mean) << clip_name;  // same rig: within 3x of the LBS baseline
+  EXPECT_LE(eh.mean, 3 * el.mean) << clip_name;     // the issue: within 3x of the LBS baseline
+  EXPECT_LE(eh.mean, 1.25 * el.mean) << clip_name;  // measured 0.78x / 1.13x
   EXPECT_LT(el.mean, 0.05) << clip_name;
-  // The base's weights learned from poses instead of the skin (a source whose skin does not
-  // describe its motion, e.g. baked simulation): still within the issue's bound.
-  auto learned = job("anim/KayKit/Knight.glb", "anim/KayKit/Barbarian.glb", clip_name, 10, -1, "",
-                     mm::app::RetargetMethod::Harmonic, [](mm::HarmonicRetargetOptions& o) { o.base_skin_weights = false; });
-  ASSERT_TRUE(learned->status.ok()) << learned->status.message;
-  std::vector<Eigen::MatrixXd> vw;
-  ASSERT_TRUE(learned->session.frames(0, learned->session.num_frames(), &vw).ok());
-  const mm::SequenceError ew = mm::sequence_vertex_error(vw, gt, H);
-  std::cout << "[ Knight -> Barbarian vs Barbarian's own " << clip_name << ", learned base weights ] " << ew.mean << "\n";
-  EXPECT_LE(ew.mean, 0.008) << clip_name;
-  EXPECT_LT(eh.mean, ew.mean) << clip_name;  // the skin's weights are the better start
+  // The Barbarian treated as unrigged (its skin's weights off, the Knight's carried over), and
+  // the source's weights learned from poses instead of its skin (a source whose skin does not
+  // describe its motion, e.g. baked simulation): both within the issue's bound, both worse.
+  double prev = eh.mean;
+  for (const bool learn : {false, true}) {
+    auto v = job("anim/KayKit/Knight.glb", "anim/KayKit/Barbarian.glb", clip_name, 10, -1, "",
+                 mm::app::RetargetMethod::Harmonic, [&](mm::HarmonicRetargetOptions& o) {
+                   o.base_target_skin = false;
+                   o.base_skin_weights = !learn;
+                 });
+    ASSERT_TRUE(v->status.ok()) << v->status.message;
+    std::vector<Eigen::MatrixXd> vw;
+    ASSERT_TRUE(v->session.frames(0, v->session.num_frames(), &vw).ok());
+    const double e = mm::sequence_vertex_error(vw, gt, H).mean;
+    std::cout << "[ Knight -> Barbarian vs Barbarian's own " << clip_name << ", target weights carried over"
+              << (learn ? ", source weights learned" : "") << " ] " << e << "\n";
+    EXPECT_LE(e, 0.008) << clip_name;
+    EXPECT_LT(prev, e) << clip_name;
+    prev = e;
+  }
   }
 }
 

@@ -330,6 +330,25 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
       }
       const BoneBlend fallback = bone_blend(Xt, base_Jt_rest_, base_bones_);
       blend_verts_t_ = interpolate_blend(bv, source.F, face, bary, &fallback);
+      const SkinWeights& tskin = target.skin;
+      if (opt.base_target_skin && tskin.index.rows() == Xt.rows() && tskin.weight.rows() == Xt.rows() &&
+          tskin.index.cols() == tskin.weight.cols() && tskin.index.cols() > 0 && tskin.weight.allFinite()) {
+        // The target's own skin: each target joint's weight goes to the base bones its nearest
+        // used ancestor (in the target's hierarchy) drives.
+        const int nj = target.joints.size();
+        const bool tree = static_cast<int>(target.joints.parent.size()) == nj;
+        std::vector<int> used_of_t(nj, -1);
+        for (int i = 0; i < m; ++i) used_of_t[used_[i].target] = i;
+        std::vector<std::vector<int>> drives(nj);
+        for (int j = 0; j < nj; ++j) {
+          int u = j;
+          for (int guard = 0; u >= 0 && used_of_t[u] < 0 && guard <= nj; ++guard) u = tree ? target.joints.parent[u] : -1;
+          if (u < 0 || used_of_t[u] < 0) continue;
+          for (int b = 0; b < nb; ++b)
+            if (base_bones_[b].second == used_of_t[u]) drives[j].push_back(b);
+        }
+        blend_verts_t_ = skin_blend(Xt, tskin.index, tskin.weight, drives, base_Jt_rest_, base_bones_, blend_verts_t_);
+      }
     } else {
       blend_colloc_s_ = bone_blend(colloc_rest_s_, base_Js_rest_, base_bones_);
       blend_verts_t_ = bone_blend(Xt, base_Jt_rest_, base_bones_);

@@ -105,6 +105,10 @@ struct HarmonicRetargetOptions {
   // The base's bone weights: from the source's own skin (RetargetCharacter::skin) when given and
   // this is on; otherwise learned from the base frames (or by distance without them).
   bool base_skin_weights = true;
+  // The target's base weights from its own skin (RetargetCharacter::skin of the target, over its
+  // joints) when given and this is on; vertices it does not cover take the source's weights at
+  // their counterparts.
+  bool base_target_skin = true;
   double base_fit_weight = 0.3;     // a source vertex joins a bone's rigid fit from this weight on (weighed by w²)
   int base_frames = 16;             // source poses the job hands over for learning the weights (spread over all clips)
 
