@@ -51,6 +51,8 @@ const OptionSchema<RetargetJobOptions>& retarget_options() {
     s.choice<bool>("target_weights", [](O& o) -> bool& { return o.harmonic.base_target_skin; },
                    {{"skin", true}, {"transferred", false}},
                    "the articulated base's weights on a rigged target: its own skin, or the source's carried over");
+    s.number("target_smoothing", [](O& o) -> double& { return o.harmonic.base_target_smoothing; }, 0, 1,
+             "carried-over target weights diffused over about this × the target's diagonal (0 = off)");
     s.choice<bool>("base_weights", [](O& o) -> bool& { return o.harmonic.base_skin_weights; },
                    {{"skin", true}, {"learned", false}},
                    "the articulated base's bone weights: the source's own skin, or learned from poses over all its clips");

@@ -6,6 +6,8 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
 
 namespace mm {
 
@@ -223,6 +225,57 @@ BoneBlend skin_blend(const Eigen::MatrixXd& P, const Eigen::MatrixXi& index, con
       if (i < fallback.rows())
         for (int k = fallback.ptr[i]; k < fallback.ptr[i + 1]; ++k) acc.push_back({fallback.w[k], fallback.bone[k]});
     }
+    push_row(acc, &out);
+  }
+  return out;
+}
+
+BoneBlend smooth_blend(const BoneBlend& W, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, int nb, double sigma) {
+  const Eigen::Index n = V.rows();
+  if (!(sigma > 0) || n == 0 || F.rows() == 0 || nb <= 0 || W.rows() != n) return W;
+  // Edges once each (both orientations of a face's sides), mean length.
+  std::vector<std::pair<int, int>> edges;
+  edges.reserve(3 * F.rows());
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      const int a = F(f, c), b = F(f, (c + 1) % 3);
+      if (a != b) edges.push_back({std::min(a, b), std::max(a, b)});
+    }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  double ell = 0;
+  for (const auto& [a, b] : edges) ell += (V.row(a) - V.row(b)).norm();
+  ell /= std::max<size_t>(1, edges.size());
+  if (!(ell > 0)) return W;
+  const double t = (sigma / ell) * (sigma / ell);
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(4 * edges.size() + n);
+  for (Eigen::Index i = 0; i < n; ++i) trip.emplace_back(i, i, 1.0);
+  for (const auto& [a, b] : edges) {
+    trip.emplace_back(a, a, t);
+    trip.emplace_back(b, b, t);
+    trip.emplace_back(a, b, -t);
+    trip.emplace_back(b, a, -t);
+  }
+  Eigen::SparseMatrix<double> A(n, n);
+  A.setFromTriplets(trip.begin(), trip.end());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(A);
+  if (solver.info() != Eigen::Success) return W;
+  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, nb);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (int k = W.ptr[i]; k < W.ptr[i + 1]; ++k) D(i, W.bone[k]) += W.w[k];
+  const Eigen::MatrixXd S = solver.solve(D);
+  if (!S.allFinite()) return W;
+  BoneBlend out;
+  std::vector<std::pair<double, int>> acc;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    acc.clear();
+    if (W.ptr[i] == W.ptr[i + 1]) {  // a point without bones stays without
+      out.ptr.push_back(static_cast<int>(out.bone.size()));
+      continue;
+    }
+    for (int b = 0; b < nb; ++b)
+      if (S(i, b) > 1e-12) acc.push_back({S(i, b), b});
     push_row(acc, &out);
   }
   return out;

@@ -64,6 +64,12 @@ BoneBlend skin_blend(const Eigen::MatrixXd& P, const Eigen::MatrixXi& index, con
                      const std::vector<std::vector<int>>& drives, const Eigen::MatrixXd& J,
                      const std::vector<std::pair<int, int>>& bones, const BoneBlend& fallback);
 
+// Weights diffused over a surface (V, F): W' = (I + (σ/ℓ)² L)⁻¹ W per bone, with L the graph
+// Laplacian of the mesh's edges and ℓ its mean edge length, so the blend zone spans about σ in
+// length units; separate components stay separate. nb: number of bones. Rows re-cut to
+// kMaxBones (the next weight subtracted). σ ≤ 0 returns W.
+BoneBlend smooth_blend(const BoneBlend& W, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, int nb, double sigma);
+
 // A start for templates far from the target's pose (e.g. a rest pose onto a walk frame, where
 // closest points pull a swung arm onto the body and the stiff first ICP steps never let go): each
 // bone turns by the smallest rotation taking J0(child) − J0(parent) onto J1(child) − J1(parent)

@@ -330,6 +330,7 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
       }
       const BoneBlend fallback = bone_blend(Xt, base_Jt_rest_, base_bones_);
       blend_verts_t_ = interpolate_blend(bv, source.F, face, bary, &fallback);
+      blend_verts_t_ = smooth_blend(blend_verts_t_, Xt, target.F, nb, opt.base_target_smoothing);
       const SkinWeights& tskin = target.skin;
       if (opt.base_target_skin && tskin.index.rows() == Xt.rows() && tskin.weight.rows() == Xt.rows() &&
           tskin.index.cols() == tskin.weight.cols() && tskin.index.cols() > 0 && tskin.weight.allFinite()) {
