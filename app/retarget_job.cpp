@@ -63,6 +63,8 @@ const OptionSchema<RetargetJobOptions>& retarget_options() {
              "λ_spatial, context-graph Laplacian weight (Sec. 7.2: 0.8)");
     s.number("w_volume", [](O& o) -> double& { return o.harmonic.w_volume; }, 0, kUnbounded,
              "λ_volume, volume-graph Laplacian weight (Sec. 7.2: 1)");
+    s.number("w_volume_base", [](O& o) -> double& { return o.harmonic.w_volume_base; }, 0, kUnbounded,
+             "λ_volume with the articulated base (it keeps the volume already; the term then damps the maps' residual)");
     s.number("graph_max_edge", [](O& o) -> double& { return o.harmonic.graph.max_edge_length; }, 0, 10,
              "context graph: edges longer than this × the height are pruned (Sec. 6.1: 0.5)");
     s.integer("graph_frames", [](O& o) -> int& { return o.graph_frames; }, 0, 10000,

@@ -443,15 +443,17 @@ TEST(ContextGraphReal, AccuracyWithAndWithoutTheGraph) {
   }
 }
 
-// The context graph on top of the articulated base (the retargeter's default): E_spatial and
-// E_volume ask the maps for what the base leaves at the graph's nodes, the bones' rotations come
-// from the base. Measured with the skin's weights: CesiumMan self-retargeting 0.00079 without the
-// graph, 0.0058 with it (the ICP's target nodes are off by up to 2% of the height, and the graph
-// asks the maps to restore their Laplacian coordinates; the maps alone: 0.0042 / 0.0080); Knight →
-// Barbarian contacts kept Lie_Idle 1.0 / 1.0, Sit_Floor_Idle 1.0 / 1.0 (the base alone keeps every
-// contact); new self-intersecting pairs per frame 1094 vs 1099 and 967 vs 964: the base moves the
-// parts like LBS (1377 / 1017) and the graph no longer lowers that; the Barbarian's own clip has
-// 467 / 303, the maps alone 300–353 / 157–204 (docs/retarget.md).
+// The context graph on top of the articulated base (the retargeter's default): E_spatial asks the
+// maps for what the base leaves at the graph's nodes, the bones' rotations come from the base, and
+// E_volume has weight w_volume_base = 0 (the base moves the volume graph bone by bone already;
+// with weight 1 and the rest coordinates turned per bone as its right-hand side, CesiumMan
+// self-retargeting was 0.0058; with weight 1 and right-hand side 0, 0.0022 and Sit_Floor_Idle
+// contacts 0.83). Measured with the skin's weights: CesiumMan self-retargeting 0.00070 with the
+// graph, 0.00079 without (the maps alone: 0.0080 / 0.0042); Knight → Barbarian contacts kept 1.0 /
+// 1.0 on Lie_Idle and Sit_Floor_Idle (the base alone keeps every contact, as LBS does on this
+// same-rig pair); new self-intersecting pairs per frame 465 vs 514 and 389 vs 416 (the
+// Barbarian's own clip 467 / 303, LBS 1377 / 1017); mean vertex error against the Barbarian's own
+// clip 0.0085 vs 0.0098 and 0.0092 vs 0.0091.
 TEST(ContextGraphReal, WithTheArticulatedBase) {
   auto with_base = [](mm::app::RetargetJobOptions& o) { o.harmonic.articulated_base = true; };
   for (const char* path : {"anim/CesiumMan/CesiumMan.glb"}) {
@@ -465,8 +467,8 @@ TEST(ContextGraphReal, WithTheArticulatedBase) {
       e[g] = mm::sequence_vertex_error(f.V, gt, up_extent(j->session.target_rest())).mean;
       std::cout << "[ base, self-retargeting " << path << (g ? " with" : " without") << " graph ] " << e[g] << "\n";
     }
-    EXPECT_LT(e[1], 0.0080);  // better than the graph on the maps alone (0.0080)
-    EXPECT_LT(e[0], e[1]);
+    EXPECT_LT(e[1], 0.005);         // issue 15's self-retargeting bound, with the graph
+    EXPECT_LT(e[1], 1.1 * e[0]);    // the graph costs the base no accuracy
   }
   for (const char* clip : {"Lie_Idle", "Sit_Floor_Idle"}) {
     auto on = gjob("anim/KayKit/Knight.glb", "anim/KayKit/Barbarian.glb", clip, 10, 0, -1, true, "",
@@ -492,8 +494,7 @@ TEST(ContextGraphReal, WithTheArticulatedBase) {
               << ", the Barbarian's own clip " << si_own << "\n";
     EXPECT_GE(a.fraction(), b.fraction()) << clip;
     EXPECT_GE(a.fraction(), 0.8) << clip;  // issue 15's contact bound, met by the base with or without the graph
-    // Within 2% of the base without the graph (it lowered them on the learned weights: 891 vs 923).
-    EXPECT_LT(si_on, 1.02 * si_off) << clip;
+    EXPECT_LT(si_on, si_off) << clip;
   }
 }
 

@@ -674,10 +674,17 @@ RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) cons
       return C;
     };
     const Eigen::MatrixXd Pa = src_nodes_.positions(Xs, src_F_);
-    W_graph = Gsp_pos_ * Pa + Gsp_corr_ * rotated(sp_corr_, sp_bone_) + Gvol_ * rotated(vol_delta_, vol_bone_);
-    if (base_on_)  // the maps carry what the base leaves of both graphs' Laplacian coordinates
-      W_graph -= Gsp_corr_ * (Lsp_ * apply_bone_motions(blend_Va_, Va_, Mt)) +
-                 Gvol_ * (Lvol_ * apply_bone_motions(blend_vol_, Xvol_, Mt));
+    W_graph = Gsp_pos_ * Pa + Gsp_corr_ * rotated(sp_corr_, sp_bone_);
+    if (base_on_) {
+      // The maps carry what the base leaves of the context graph's Laplacian coordinates. The
+      // volume graph's: the base already moves it bone by bone, so E_volume (weight w_volume_base)
+      // asks the residual to leave its Laplacian coordinates as the base has them (right-hand
+      // side 0). Asking for the rest coordinates turned by one bone per row instead fought the
+      // base's blend at the joints (CesiumMan self-retargeting 0.0058 with it).
+      W_graph -= Gsp_corr_ * (Lsp_ * apply_bone_motions(blend_Va_, Va_, Mt));
+    } else {
+      W_graph += Gvol_ * rotated(vol_delta_, vol_bone_);
+    }
     Jt_fixed += Kt_joints_ * W_graph;
   }
   Eigen::MatrixXd Jt_now = nb > 0 ? Eigen::MatrixXd(Jt_fixed + KtGb_ * (dirs - base_dirs)) : Jt_fixed;

@@ -244,7 +244,9 @@ Status HarmonicRetargeter::build_context_graph(const Eigen::MatrixXd& Xs, const 
     vol_bone_.resize(static_cast<Eigen::Index>(vrows.size()));
     for (size_t r = 0; r < vrows.size(); ++r) vol_bone_[r] = bone_of[vrows[r]];
     term_volume_ = synth_.add_term({"volume", Eigen::MatrixXd(Lv * mfs_kernel(Xv, U)) / graph_vol_len_,
-                                    opt.w_volume / std::max<size_t>(1, vrows.size()), false});
+                                    (opt.articulated_base && !bones_.empty() ? opt.w_volume_base : opt.w_volume) /
+                                        std::max<size_t>(1, vrows.size()),
+                                    false});
     graph_.volume_nodes = graph_to_units(Xv, ct_, Lt_, R_);
     graph_.volume_edges = edges;
     graph_.volume_surface = ns;
