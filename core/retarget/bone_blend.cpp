@@ -9,6 +9,8 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
+#include "retarget/nonrigid_icp.h"
+
 namespace mm {
 
 std::pair<int, double> BoneBlend::dominant(int i) const {
@@ -233,16 +235,7 @@ BoneBlend skin_blend(const Eigen::MatrixXd& P, const Eigen::MatrixXi& index, con
 BoneBlend smooth_blend(const BoneBlend& W, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, int nb, double sigma) {
   const Eigen::Index n = V.rows();
   if (!(sigma > 0) || n == 0 || F.rows() == 0 || nb <= 0 || W.rows() != n) return W;
-  // Edges once each (both orientations of a face's sides), mean length.
-  std::vector<std::pair<int, int>> edges;
-  edges.reserve(3 * F.rows());
-  for (Eigen::Index f = 0; f < F.rows(); ++f)
-    for (int c = 0; c < 3; ++c) {
-      const int a = F(f, c), b = F(f, (c + 1) % 3);
-      if (a != b) edges.push_back({std::min(a, b), std::max(a, b)});
-    }
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  const std::vector<std::pair<int, int>> edges = triangle_edges(F);  // each once
   double ell = 0;
   for (const auto& [a, b] : edges) ell += (V.row(a) - V.row(b)).norm();
   ell /= std::max<size_t>(1, edges.size());
