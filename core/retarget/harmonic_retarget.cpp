@@ -35,6 +35,30 @@ Eigen::MatrixXd to_working(const Eigen::MatrixXd& V, const Eigen::RowVector3d& c
   return ((V.rowwise() - c) / L) * R.transpose();
 }
 
+// A skin usable for the base: one row per surface vertex, finite weights.
+bool usable_skin(const SkinWeights& skin, Eigen::Index rows) {
+  return skin.index.rows() == rows && skin.weight.rows() == rows && skin.index.cols() == skin.weight.cols() &&
+         skin.index.cols() > 0 && skin.weight.allFinite();
+}
+
+// Per joint of J: the base bones (child, parent) whose parent end is the joint's nearest used
+// ancestor (itself included; used_of maps J's rows to used joints, −1 = not used) — the bones
+// that joint's motion drives. Empty where no ancestor is used.
+std::vector<std::vector<int>> joint_drives(const JointSet& J, const std::vector<int>& used_of,
+                                           const std::vector<std::pair<int, int>>& bones) {
+  const int nj = J.size();
+  const bool tree = static_cast<int>(J.parent.size()) == nj;
+  std::vector<std::vector<int>> drives(nj);
+  for (int j = 0; j < nj; ++j) {
+    int u = j;
+    for (int guard = 0; u >= 0 && used_of[u] < 0 && guard <= nj; ++guard) u = tree ? J.parent[u] : -1;
+    if (u < 0 || used_of[u] < 0) continue;
+    for (size_t b = 0; b < bones.size(); ++b)
+      if (bones[b].second == used_of[u]) drives[j].push_back(static_cast<int>(b));
+  }
+  return drives;
+}
+
 }  // namespace retarget_detail
 
 Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const RetargetCharacter& target,
@@ -241,9 +265,7 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
   if (base_on_) {
     Xs_rest_ = Xs;
     Xt_rest_ = Xt;
-    const SkinWeights& skin = source.skin;
-    const bool use_skin = opt.base_skin_weights && skin.index.rows() == Xs.rows() && skin.weight.rows() == Xs.rows() &&
-                          skin.index.cols() == skin.weight.cols() && skin.index.cols() > 0 && skin.weight.allFinite();
+    const bool use_skin = opt.base_skin_weights && usable_skin(source.skin, Xs.rows());
     // Leaf bones only with the skin: learned weights spread worse over the extra candidates
     // (Knight → Barbarian 0.0075 → 0.0094 of the height with them).
     build_base_skeleton(Xs, use_skin);
@@ -286,17 +308,8 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
     if (use_skin) {
       // The source's own skin: each joint's weight goes to the base bones its nearest used
       // ancestor drives (the bones leaving it, its leaf bone).
-      const int nj = source.joints.size();
-      std::vector<std::vector<int>> drives(nj);
-      for (int j = 0; j < nj; ++j) {
-        int u = j;
-        for (int guard = 0; u >= 0 && used_of[u] < 0 && guard <= nj; ++guard)
-          u = has_tree ? source.joints.parent[u] : -1;
-        if (u < 0 || used_of[u] < 0) continue;
-        for (int b = 0; b < nb; ++b)
-          if (base_bones_[b].second == used_of[u]) drives[j].push_back(b);
-      }
-      bv = skin_blend(Xs, skin.index, skin.weight, drives, base_Js_rest_, base_bones_, bv);
+      bv = skin_blend(Xs, source.skin.index, source.skin.weight, joint_drives(source.joints, used_of, base_bones_),
+                      base_Js_rest_, base_bones_, bv);
       fit_sets(bv);
       learned = true;
     } else if (!samples.empty()) {
@@ -331,24 +344,15 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
       const BoneBlend fallback = bone_blend(Xt, base_Jt_rest_, base_bones_);
       blend_verts_t_ = interpolate_blend(bv, source.F, face, bary, &fallback);
       blend_verts_t_ = smooth_blend(blend_verts_t_, Xt, target.F, nb, opt.base_target_smoothing);
-      const SkinWeights& tskin = target.skin;
-      if (opt.base_target_skin && tskin.index.rows() == Xt.rows() && tskin.weight.rows() == Xt.rows() &&
-          tskin.index.cols() == tskin.weight.cols() && tskin.index.cols() > 0 && tskin.weight.allFinite()) {
+      if (opt.base_target_skin && usable_skin(target.skin, Xt.rows())) {
         // The target's own skin: each target joint's weight goes to the base bones its nearest
-        // used ancestor (in the target's hierarchy) drives.
-        const int nj = target.joints.size();
-        const bool tree = static_cast<int>(target.joints.parent.size()) == nj;
-        std::vector<int> used_of_t(nj, -1);
+        // used ancestor (in the target's hierarchy) drives; rows it does not cover keep the
+        // carried-over weights.
+        std::vector<int> used_of_t(target.joints.size(), -1);
         for (int i = 0; i < m; ++i) used_of_t[used_[i].target] = i;
-        std::vector<std::vector<int>> drives(nj);
-        for (int j = 0; j < nj; ++j) {
-          int u = j;
-          for (int guard = 0; u >= 0 && used_of_t[u] < 0 && guard <= nj; ++guard) u = tree ? target.joints.parent[u] : -1;
-          if (u < 0 || used_of_t[u] < 0) continue;
-          for (int b = 0; b < nb; ++b)
-            if (base_bones_[b].second == used_of_t[u]) drives[j].push_back(b);
-        }
-        blend_verts_t_ = skin_blend(Xt, tskin.index, tskin.weight, drives, base_Jt_rest_, base_bones_, blend_verts_t_);
+        blend_verts_t_ = skin_blend(Xt, target.skin.index, target.skin.weight,
+                                    joint_drives(target.joints, used_of_t, base_bones_), base_Jt_rest_, base_bones_,
+                                    blend_verts_t_);
       }
     } else {
       blend_colloc_s_ = bone_blend(colloc_rest_s_, base_Js_rest_, base_bones_);
