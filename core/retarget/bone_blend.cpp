@@ -200,6 +200,7 @@ BoneBlend skin_blend(const Eigen::MatrixXd& P, const Eigen::MatrixXi& index, con
                      const std::vector<std::pair<int, int>>& bones, const BoneBlend& fallback) {
   BoneBlend out;
   std::vector<std::pair<double, int>> acc;
+  std::vector<double> raw;
   for (Eigen::Index i = 0; i < P.rows(); ++i) {
     acc.clear();
     const Eigen::Vector3d x = P.row(i).transpose();
@@ -214,7 +215,7 @@ BoneBlend skin_blend(const Eigen::MatrixXd& P, const Eigen::MatrixXi& index, con
       // Split among the joint's bones by 1/d⁴ (a tiny floor keeps points on a segment finite).
       const double floor = 1e-9 * (1.0 + x.norm());
       double norm = 0;
-      std::vector<double> raw;
+      raw.clear();
       for (int b : drives[j]) {
         const double d = std::max(segment_distance(x, J, bones[b]), floor);
         raw.push_back(std::pow(d, -4.0));

@@ -297,7 +297,6 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
           base_fit_w_[b] = loose_w[b];
         }
     };
-    fit_sets(bv);
     // Weights learned from the clip (surface only: which bones' motions explain each source
     // vertex over the sample frames), carried to the target through bone coordinates.
     std::vector<Eigen::MatrixXd> samples;
@@ -310,9 +309,9 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
       // ancestor drives (the bones leaving it, its leaf bone).
       bv = skin_blend(Xs, source.skin.index, source.skin.weight, joint_drives(source.joints, used_of, base_bones_),
                       base_Js_rest_, base_bones_, bv);
-      fit_sets(bv);
       learned = true;
     } else if (!samples.empty()) {
+      fit_sets(bv);  // the distance weights' fits give the sample poses' bone motions
       const BoneBlend candidates = bone_blend(Xs, base_Js_rest_, base_bones_, 3.0);
       std::vector<BoneMotions> motions;
       for (const Eigen::MatrixXd& Xf : samples) {
@@ -321,9 +320,9 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
         motions.push_back(source_base(Xf, &Jb, &Rf));
       }
       bv = learn_bone_weights(Xs, samples, motions, candidates);
-      fit_sets(bv);
       learned = true;
     }
+    fit_sets(bv);
     colloc_rest_s_ = src_map_.collocation_positions(Xs);
     if (learned) {
       const SurfaceSamples& C = src_map_.collocation();
@@ -359,21 +358,9 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
       blend_verts_t_ = bone_blend(Xt, base_Jt_rest_, base_bones_);
     }
     if (graph_on_) {
-      // The base at the graph's target nodes (on the surface: the vertices' weights there) and
-      // at the volume graph's nodes (surface samples likewise; interior nodes lie on bones).
+      // The base at the graph's target nodes (on the surface: the vertices' weights there). The
+      // volume graph needs none: with the base its right-hand side is 0 (see retarget()).
       blend_Va_ = interpolate_blend(blend_verts_t_, target.F, graph_.target_face, graph_.target_barycentric);
-      const SurfaceSamples& C = tgt_map_.collocation();
-      const int ns = graph_.volume_surface, nv = static_cast<int>(Xvol_.rows());
-      const BoneBlend inner = bone_blend(Xvol_.bottomRows(nv - ns), base_Jt_rest_, base_bones_);
-      const BoneBlend surf = interpolate_blend(blend_verts_t_, target.F, C.face.head(ns), C.barycentric.topRows(ns));
-      blend_vol_ = surf;
-      for (int i = 0; i < inner.rows(); ++i) {
-        for (int k = inner.ptr[i]; k < inner.ptr[i + 1]; ++k) {
-          blend_vol_.bone.push_back(inner.bone[k]);
-          blend_vol_.w.push_back(inner.w[k]);
-        }
-        blend_vol_.ptr.push_back(static_cast<int>(blend_vol_.bone.size()));
-      }
     }
     // Forward-kinematics order: from each root down (base bones are (child, parent) joint pairs).
     const int mb = static_cast<int>(base_Js_rest_.rows());

@@ -98,8 +98,8 @@ struct HarmonicRetargetOptions {
   // joints get bones of their own (a head, a hand, a foot under an IK root).
   // The MFS maps then carry only the residual — the fit's floor (0.011 of the height with 260
   // singularities on KayKit's rigid parts) no longer applies to the articulated motion. With
-  // the context graph, E_spatial and E_volume ask the maps for what the base leaves at the graph
-  // nodes. Every step is continuous in the input (weights, fits, correspondences), so native
+  // the context graph, E_spatial asks the maps for what the base leaves at the graph nodes and
+  // E_volume (weight w_volume_base) only damps their residual. Every step is continuous in the input (weights, fits, correspondences), so native
   // and wasm agree.
   bool articulated_base = true;
   // The base's bone weights: from the source's own skin (RetargetCharacter::skin) when given and
@@ -272,9 +272,7 @@ class HarmonicRetargeter {
   Eigen::VectorXi sp_bone_;             // #rows bone whose rotation turns sp_corr_ (-1: none)
   Eigen::MatrixXd Gsp_pos_, Gsp_corr_;  // N_a by #N, N_a by #rows
   Eigen::MatrixXd vol_delta_;           // #rows_v by 3 rest Laplacian coordinates of the volume graph
-  Eigen::SparseMatrix<double> Lvol_;    // #rows_v by #Nv volume-graph Laplacian rows
-  Eigen::MatrixXd Xvol_;                // #Nv by 3 volume-graph nodes (working)
-  BoneBlend blend_Va_, blend_vol_;      // articulated base at the target nodes and volume nodes
+  BoneBlend blend_Va_;                  // articulated base at the target nodes
   Eigen::VectorXi vol_bone_;            // #rows_v
   Eigen::MatrixXd Gvol_;                // N_a by #rows_v
   Eigen::MatrixXd DmidVS_;              // 3·#bones by r: source Jacobians at bone midpoints from Ys

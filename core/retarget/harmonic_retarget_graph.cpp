@@ -239,8 +239,6 @@ Status HarmonicRetargeter::build_context_graph(const Eigen::MatrixXd& Xs, const 
     for (const auto& [i, j] : edges) len += (Xv.row(i) - Xv.row(j)).norm();
     graph_vol_len_ = std::max(1e-9, len / std::max<size_t>(1, edges.size()));
     vol_delta_ = Lv * Xv;
-    Lvol_ = Lv;
-    Xvol_ = Xv;
     vol_bone_.resize(static_cast<Eigen::Index>(vrows.size()));
     for (size_t r = 0; r < vrows.size(); ++r) vol_bone_[r] = bone_of[vrows[r]];
     term_volume_ = synth_.add_term({"volume", Eigen::MatrixXd(Lv * mfs_kernel(Xv, U)) / graph_vol_len_,
