@@ -197,13 +197,32 @@ export class PlaywrightLikePage {
 
 // Runs `tests` ([{name, fn}]) in Firefox against baseUrl. `extra` are added to each test's
 // arguments. Returns {passed, failed, version}; prints one line per test like run.mjs.
-export async function runInFirefox({ tests, baseUrl, initScripts, shotDir, shotPrefix = 'firefox-', log = console.log }) {
+// Resolves with fn()'s value or with `fallback` after ms (a wedged browser must not hang us).
+const within = (promise, ms, fallback) => Promise.race([promise, sleep(ms).then(() => fallback)]);
+
+// What the page shows when it is not ready: enough to tell a slow start from a wedged one.
+async function startupState(raw) {
+  return within(raw.evaluate(() => ({
+    readyState: document.readyState,
+    isolated: window.crossOriginIsolated,
+    app: Boolean(window.__meshmorph),
+    status: document.getElementById('status')?.textContent ?? null,
+    error: window.__meshmorph?.state.error ?? null,
+  })).then((s) => JSON.stringify(s), (e) => `evaluate failed: ${e.message}`), 10000, 'the page did not answer in 10 s');
+}
+
+// One Firefox on its own Xvfb with the page loaded and its worker ready, or an error saying what
+// the page showed. Callers close it with close().
+// pageErrors and consoleSink.lines receive the page's errors and console errors/warnings.
+async function openFirefox({ baseUrl, initScripts, readyTimeout, pageErrors, consoleSink }) {
   const { launch } = await import('puppeteer-core');
   const xvfb = await startXvfb();
   let browser = null;
-  let passed = 0;
-  let failed = 0;
-  let version = '';
+  const close = async () => {
+    await within(browser?.close().catch(() => {}) ?? Promise.resolve(), 15000);
+    browser?.process()?.kill('SIGKILL');
+    xvfb.stop();
+  };
   try {
     browser = await launch({
       browser: 'firefox',
@@ -213,22 +232,62 @@ export async function runInFirefox({ tests, baseUrl, initScripts, shotDir, shotP
       env: { ...process.env, DISPLAY: xvfb.display, MOZ_ENABLE_WAYLAND: '0' },
       extraPrefsFirefox: { 'browser.download.useDownloadDir': true, 'browser.download.always_ask_before_handling_new_types': false },
     });
-    version = await browser.version();
     const raw = await browser.newPage();
     for (const script of [captureDownloads, ...initScripts]) await raw.evaluateOnNewDocument(script);
-    const page = new PlaywrightLikePage(raw, { shotPrefix });
-    const pageErrors = [];
+    // Listening from before the page loads: errors while it starts count too.
     raw.on('pageerror', (e) => pageErrors.push(e.message));
-    let consoleLines = [];
-    const allConsole = [];
     raw.on('console', (m) => {
       const type = m.type() === 'warn' ? 'warning' : m.type();
-      if (type === 'error' || type === 'warning') consoleLines.push(`[firefox ${type}] ${m.text()}`);
+      if (type === 'error' || type === 'warning') consoleSink.lines.push(`[firefox ${type}] ${m.text()}`);
     });
     await raw.goto(baseUrl);
+    try {
+      await raw.waitForFunction(() => window.__meshmorph?.state.ready || window.__meshmorph?.state.error, { timeout: readyTimeout, polling: 200 });
+    } catch (e) {
+      throw new Error(`the page was not ready after ${readyTimeout / 1000} s: ${await startupState(raw)}; console: ${consoleSink.lines.join(' | ') || 'nothing'}`);
+    }
+    return { browser, raw, close };
+  } catch (e) {
+    await close();
+    throw e;
+  }
+}
+
+// Runs `tests` ([{name, fn}]) in Firefox against baseUrl. `extra` are added to each test's
+// arguments. Returns {passed, failed, version}; prints one line per test like run.mjs.
+// A Firefox whose page never gets ready (seen once in CI: every wait timed out, no console
+// line) is started again once, with what the page showed printed; a second failure fails
+// every test at once instead of waiting a minute in each.
+export async function runInFirefox({ tests, baseUrl, initScripts, shotDir, shotPrefix = 'firefox-', log = console.log }) {
+  let session = null;
+  const pageErrors = [];
+  const consoleSink = { lines: [] };
+  let passed = 0;
+  let failed = 0;
+  let version = '';
+  for (let attempt = 1; attempt <= 2 && !session; ++attempt) {
+    try {
+      pageErrors.length = 0;
+      consoleSink.lines = [];
+      session = await openFirefox({ baseUrl, initScripts, readyTimeout: 90000, pageErrors, consoleSink });
+    } catch (e) {
+      log(`note [firefox] start ${attempt} of 2 failed: ${String(e.message || e).split('\n')[0]}`);
+    }
+  }
+  if (!session) {
+    for (const t of tests) log(`FAIL [firefox] ${t.name} (Firefox did not start the page twice; see the notes above)`);
+    return { passed: 0, failed: tests.length, version: 'not started' };
+  }
+  const { browser, raw, close } = session;
+  try {
+    version = await browser.version();
+    const page = new PlaywrightLikePage(raw, { shotPrefix });
+    const allConsole = [];
     for (const t of tests) {
       const started = Date.now();
-      consoleLines = [];
+      // The first test also sees what the page printed while it started.
+      if (t !== tests[0]) consoleSink.lines = [];
+      const consoleLines = consoleSink.lines;
       try {
         await t.fn({ page, context: null, baseUrl, pageErrors, allConsole, consoleLines, browser: 'firefox' });
         allConsole.push(...consoleLines.map((l) => `${t.name}: ${l}`));
@@ -243,8 +302,7 @@ export async function runInFirefox({ tests, baseUrl, initScripts, shotDir, shotP
       }
     }
   } finally {
-    await browser?.close().catch(() => {});
-    xvfb.stop();
+    await close();
   }
   return { passed, failed, version };
 }

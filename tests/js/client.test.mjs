@@ -129,6 +129,24 @@ test('a worker that fails to start is replaced; after too many failures requests
   dead.client.dropWorker();
 });
 
+test('a worker that never answers its start is replaced after the start timeout, and the page hears why', async () => {
+  const hangInits = new Int32Array(new SharedArrayBuffer(4));
+  Atomics.store(hangInits, 0, 1);
+  const notes = [];
+  const slow = makeClient({ maxInitAttempts: 3, startTimeoutMs: 3000, onStatus: (text) => notes.push(text) }, { hangInits });
+  try {
+    const started = Date.now();
+    await slow.client.ready;
+    assert.equal(slow.started(), 2, 'one hung start, then a good one');
+    assert.ok(Date.now() - started >= 2900, 'the hung worker was given its time');
+    assert.ok(notes.some((n) => /attempt 1.*no answer from the worker in 3 s/.test(n)), `notes: ${notes.join(' | ')}`);
+    const { info } = await slow.client.run('load', { name: 'hand.ply' }, { 'hand.ply': dataBytes('edit/hand_lowres.ply') }).promise;
+    assert.equal(info.weldedVertices, 810);
+  } finally {
+    slow.client.dropWorker();
+  }
+});
+
 test('a wasm trap replaces the worker and restores the mesh', async () => {
   const { client, started } = makeClient();
   try {

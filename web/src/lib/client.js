@@ -23,7 +23,9 @@ export class MeshMorphClient {
   // createWorker: () => Worker-like {postMessage, terminate, onmessage, onerror}.
   // cancelMode: 'auto' (cooperative when crossOriginIsolated), 'cooperative' or 'terminate'.
   // onStatus: (text) => void, for diagnostics (worker restarts).
-  constructor({ createWorker, threadedModuleUrl = null, maxInitAttempts = 3, cancelGraceMs = 2000, cancelMode = 'auto', onStatus = () => {}, onRestart = () => {} }) {
+  // startTimeoutMs: a worker that neither says 'ready' nor fails within this time is replaced
+  // (doubling the wait each attempt: a slow machine compiling the module is not a hang).
+  constructor({ createWorker, threadedModuleUrl = null, maxInitAttempts = 3, startTimeoutMs = 30000, cancelGraceMs = 2000, cancelMode = 'auto', onStatus = () => {}, onRestart = () => {} }) {
     this.createWorker = createWorker;
     // The threaded wasm build needs shared memory: offered to the worker only when this page is
     // crossOriginIsolated (worker/worker.js falls back to the single-threaded build otherwise).
@@ -31,6 +33,7 @@ export class MeshMorphClient {
     this.threads = { threaded: false, maxThreads: 1 }; // from the worker's 'ready'
     this.onRestart = onRestart;
     this.maxInitAttempts = maxInitAttempts;
+    this.startTimeoutMs = startTimeoutMs;
     this.cancelGraceMs = cancelGraceMs;
     this.onStatus = onStatus;
     const sharedMemory = typeof SharedArrayBuffer === 'function';
@@ -59,7 +62,7 @@ export class MeshMorphClient {
     let lastError = null;
     for (let attempt = 1; attempt <= this.maxInitAttempts; ++attempt) {
       try {
-        const ready = await this.startOne();
+        const ready = await this.startOne(this.startTimeoutMs * 2 ** (attempt - 1));
         await this.replayRestore();
         return ready;
       } catch (e) {
@@ -71,11 +74,13 @@ export class MeshMorphClient {
     throw new MeshMorphError('InitFailed', `the geometry worker could not start: ${lastError?.message || lastError}`);
   }
 
-  startOne() {
+  startOne(timeoutMs) {
+    let timer = null;
     return new Promise((resolve, reject) => {
       const worker = this.createWorker();
       this.worker = worker;
       this.cancelFlag = this.cooperative ? new Int32Array(new SharedArrayBuffer(4)) : null;
+      timer = setTimeout(() => reject(new MeshMorphError('InitFailed', `no answer from the worker in ${Math.round(timeoutMs / 1000)} s`)), timeoutMs);
       worker.onmessage = (event) => {
         const message = event.data;
         if (message.type === 'ready') {
@@ -93,7 +98,7 @@ export class MeshMorphClient {
         reject(new MeshMorphError('InitFailed', e.message || 'worker script failed to load'));
       };
       worker.postMessage({ type: 'init', cancelFlag: this.cancelFlag, threadedModuleUrl: this.threadedModuleUrl });
-    });
+    }).finally(() => clearTimeout(timer));
   }
 
   async replayRestore() {
