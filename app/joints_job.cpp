@@ -30,6 +30,10 @@ const OptionSchema<JointsJobOptions>& joints_options() {
               "target facing axis as source_up; -1 = +z for glTF, else detect");
     s.number("leaf_tolerance", [](O& o) -> double& { return o.fit.leaf_tolerance; }, 0, 10,
              "limb ends match when at most this × height apart");
+    s.integer("surface_refine", [](O& o) -> int& { return o.fit.surface_refine_iterations; }, 0, 10,
+              "rounds of moving each joint by the local affine map of the source surface around it onto the target (0 = off)");
+    s.number("surface_refine_sigma", [](O& o) -> double& { return o.fit.surface_refine_sigma; }, 0.1, 10,
+             "that neighbourhood: Gaussian sigma = this x the joint's depth below the source surface");
     s.integer("marker_reach", [](O& o) -> int& { return o.fit.marker_reach; }, 0, 100,
               "markers also move joints up to this many bones away");
     s.boolean("check_topology", [](O& o) -> bool& { return o.fit.check_topology; },

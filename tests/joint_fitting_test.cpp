@@ -523,11 +523,12 @@ double jf_sequence_error(const JfJob& j, const std::vector<Eigen::MatrixXd>& gt)
 TEST(JointFittingRetarget, AutoJointsWithinATquarterOfTrueJoints) {
   // Knight → Barbarian against Barbarian's own Walking_A, and self-retargeting of the Knight.
   // The paper's maps alone (articulated base off) — the 1.25× of issue 14: measured true 0.0219,
-  // auto 0.0260 (1.19×). With the articulated base (the default since the fifteenth session) the
+  // auto 0.0237 (1.08×). With the articulated base (the default since the fifteenth session) the
   // bones pivot at the fitted joints, so joint placement matters more. The true joints' run treats
   // the Barbarian as unrigged too (its own skin's weights off, as with automatic joints): true
-  // 0.0049, auto 0.0087 (1.79×, NOT within 1.25×; with its own skin the true joints give 0.0024)
-  // — still well below the paper's maps with the true joints.
+  // 0.0049, auto 0.0071 (1.45×, NOT within 1.25×; 0.0087 before the surface refinement, step 5b;
+  // with its own skin the true joints give 0.0024) — still well below the paper's maps with the
+  // true joints (docs/retarget.md: which joints the rest comes from).
   for (const bool base : {false, true}) {
     auto truej = jf_job("anim/KayKit/Knight.glb", "anim/KayKit/Barbarian.glb", "", base, false);
     auto autoj = jf_job("anim/KayKit/Knight.glb", "anim/KayKit/Barbarian.glb", "auto", base);
@@ -546,7 +547,7 @@ TEST(JointFittingRetarget, AutoJointsWithinATquarterOfTrueJoints) {
       RecordProperty("knight_barbarian_auto", std::to_string(ea));
       EXPECT_LE(ea, 1.25 * et);
     } else {
-      EXPECT_LE(ea, 0.015);
+      EXPECT_LE(ea, 0.0085);  // measured 0.0071
     }
   }
   for (const char* c : {"anim/KayKit/Knight.glb", "anim/CesiumMan/CesiumMan.glb"}) {
@@ -612,4 +613,3 @@ TEST(JointsJob, JsonReadsBackAndDrivesRetarget) {
   EXPECT_EQ(bad.status.code, mm::StatusCode::InvalidArgument);
   EXPECT_NE(bad.status.message.find("chin"), std::string::npos);
 }
-

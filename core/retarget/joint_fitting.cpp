@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 
+#include "retarget/bone_blend.h"
 #include "spatial/triangle_bvh.h"
 
 namespace mm {
@@ -403,15 +404,83 @@ std::vector<int> jf_split_touching_legs(CurveSkeleton* T, const JfTree& tt, cons
   return remap;
 }
 
+// Step 5b: each placed joint moved by how the source surface around it lands on the target.
+// The source surface is carried into the target's frame (the similarity of steps 2–3), posed onto
+// the fitted joints bone by bone (articulated_points), and each of its vertices paired with the
+// closest target point. A joint then takes the local affine map of those pairs (Gaussian weights
+// by the vertex's distance from the source joint, σ = surface_refine_sigma × the joint's depth
+// below the source surface, ridge toward a translation): a joint centred in a thigh stays centred
+// in a thicker thigh. Repeated `surface_refine_iterations` times (the pose follows the moved
+// joints); a move that would leave the target is not taken. Js: the placed joints' source
+// positions (rows of `out`).
+void jf_refine_by_surface(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, const Eigen::MatrixXd& Js,
+                          const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& to_target,
+                          const TriangleBvh& bvh_s, const TriangleBvh& bvh_t, const std::function<bool(const Eigen::Vector3d&)>& inside_t,
+                          double height_s, const JointFitOptions& opt, JointSet* out) {
+  const int n = out->size();
+  std::vector<std::pair<int, int>> bones;
+  for (int i = 0; i < n; ++i)
+    if (out->parent[i] >= 0) bones.push_back({i, out->parent[i]});
+  if (bones.empty() || Vs.rows() == 0) return;
+  // Vertex areas (a third of each incident triangle): uneven tessellation must not tilt the fit.
+  Eigen::VectorXd area = Eigen::VectorXd::Zero(Vs.rows());
+  for (Eigen::Index f = 0; f < Fs.rows(); ++f) {
+    const Eigen::Vector3d a = Vs.row(Fs(f, 0)), b = Vs.row(Fs(f, 1)), c = Vs.row(Fs(f, 2));
+    const double A = 0.5 * (b - a).cross(c - a).norm() / 3;
+    for (int k = 0; k < 3; ++k) area[Fs(f, k)] += A;
+  }
+  Eigen::MatrixXd Y0(Vs.rows(), 3), J0(n, 3);
+  for (Eigen::Index i = 0; i < Vs.rows(); ++i) Y0.row(i) = to_target(Vs.row(i).transpose()).transpose();
+  for (int j = 0; j < n; ++j) J0.row(j) = to_target(Js.row(j).transpose()).transpose();
+  // Neighbourhood of each joint on the source, fixed across iterations.
+  std::vector<std::vector<std::pair<int, double>>> near(n);
+  for (int j = 0; j < n; ++j) {
+    const Eigen::Vector3d pj = Js.row(j).transpose();
+    const double depth = std::sqrt(bvh_s.closest_point(pj).sq_distance);
+    const double sigma = opt.surface_refine_sigma * std::max(depth, 0.01 * height_s);
+    for (Eigen::Index i = 0; i < Vs.rows(); ++i) {
+      const double d2 = (Vs.row(i).transpose() - pj).squaredNorm();
+      if (d2 > 9 * sigma * sigma || area[i] <= 0) continue;
+      near[j].push_back({int(i), area[i] * std::exp(-0.5 * d2 / (sigma * sigma))});
+    }
+  }
+  for (int it = 0; it < opt.surface_refine_iterations; ++it) {
+    const Eigen::MatrixXd Y = articulated_points(Y0, J0, out->P, bones);
+    Eigen::MatrixXd C(Y.rows(), 3);
+    for (Eigen::Index i = 0; i < Y.rows(); ++i) C.row(i) = bvh_t.closest_point(Y.row(i).transpose()).point.transpose();
+    Eigen::MatrixXd P = out->P;
+    for (int j = 0; j < n; ++j) {
+      if (near[j].size() < 4) continue;
+      // Weighted least squares [A b] on centred points: C − c̄ ≈ A (Y − ȳ), ridge λ·(A − I).
+      double W = 0;
+      Eigen::Vector3d yb = Eigen::Vector3d::Zero(), cb = Eigen::Vector3d::Zero();
+      for (const auto& [i, w] : near[j]) W += w, yb += w * Y.row(i).transpose(), cb += w * C.row(i).transpose();
+      if (!(W > 0)) continue;
+      yb /= W, cb /= W;
+      Eigen::Matrix3d YY = Eigen::Matrix3d::Zero(), CY = Eigen::Matrix3d::Zero();
+      for (const auto& [i, w] : near[j]) {
+        const Eigen::Vector3d y = Y.row(i).transpose() - yb, c = C.row(i).transpose() - cb;
+        YY += w * y * y.transpose();
+        CY += w * c * y.transpose();
+      }
+      const double lambda = opt.surface_refine_ridge * YY.trace() / 3 + 1e-300;
+      const Eigen::Matrix3d A = (CY + lambda * Eigen::Matrix3d::Identity()) * (YY + lambda * Eigen::Matrix3d::Identity()).inverse();
+      const Eigen::Vector3d q = cb + A * (out->P.row(j).transpose() - yb);
+      if (q.allFinite() && inside_t(q)) P.row(j) = q.transpose();
+    }
+    out->P = P;
+  }
+}
+
 // Steps 2–6 on the skeletons in r (the source's tree chosen by the caller). `lost_limbs`: set when
 // the fit is refused because a source limb has no partner in the target (the case where the
 // source's own bones may still fit, SourceSkeleton::Auto).
 struct JfInputs {
   const Eigen::MatrixXd &Vs, &Vt;
-  const Eigen::MatrixXi& Ft;
+  const Eigen::MatrixXi &Fs, &Ft;
   const JointSet& source_joints;
   const std::vector<int>& used;
-  const TriangleBvh& bvh_t;
+  const TriangleBvh &bvh_s, &bvh_t;
   double tol_t;
   const std::vector<JointMarker>& markers;
   const JointFitOptions& opt;
@@ -771,6 +840,29 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     out.parent.push_back(p >= 0 ? out_index[p] : -1);
   }
 
+  // 5b. Refinement by the surfaces around the joints (jf_refine_by_surface); joints step 6 could
+  // not bring inside are left where they are.
+  if (opt.surface_refine_iterations > 0) {
+    Eigen::MatrixXd Js(out.size(), 3);
+    for (int j : used)
+      if (out_index[j] >= 0) Js.row(out_index[j]) = source_joints.P.row(j);
+    const auto to_target = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d { return R.transpose() * (ft.o + ft.H * fs(p)); };
+    const std::vector<uint8_t> was_outside = [&] {
+      std::vector<uint8_t> v(out.size(), 0);
+      for (const std::string& nm : outside) v[out.find(nm)] = 1;
+      return v;
+    }();
+    JointSet refined = out;
+    jf_refine_by_surface(Vs, in.Fs, Js, to_target, in.bvh_s, bvh_t, inside_t, fs.H, opt, &refined);
+    for (int k = 0; k < out.size(); ++k) {
+      if (was_outside[k]) continue;
+      const Eigen::Vector3d p0 = out.P.row(k).transpose(), d = refined.P.row(k).transpose() - p0;
+      const double limit = opt.surface_refine_max_move * std::max(std::sqrt(bvh_t.closest_point(p0).sq_distance), 0.01 * ft.H);
+      const Eigen::Vector3d p = d.norm() > limit ? Eigen::Vector3d(p0 + d * (limit / d.norm())) : Eigen::Vector3d(p0 + d);
+      if (inside_t(p)) out.P.row(k) = p.transpose();
+    }
+  }
+
   // Markers: pin, and drag chain neighbours within marker_reach bones.
   if (!markers.empty()) {
     std::vector<int> pinned(out.size(), 0);
@@ -870,7 +962,7 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
     else r.skipped.push_back(source_joints.names[j]);
   }
   if (used.size() < 2) return fail(StatusCode::InvalidArgument, "fewer than 2 source joints lie inside the source surface");
-  const JfInputs in{Vs, Vt, Ft, source_joints, used, bvh_t, tol_t, markers, opt, progress};
+  const JfInputs in{Vs, Vt, Fs, Ft, source_joints, used, bvh_s, bvh_t, tol_t, markers, opt, progress};
   // The source's curve skeleton first (Voxel, Auto); Auto falls back to the source's own bones
   // when a source limb finds no partner (blocky, many-part sources: KayKit's 24 limb ends).
   JointFitResult voxel;
