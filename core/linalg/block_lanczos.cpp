@@ -4,12 +4,17 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 
 #include "common/progress.h"
 #include "common/threads.h"
+
+#if defined(__wasm_simd128__)
+#include <wasm_simd128.h>
+#endif
 
 namespace mm {
 
@@ -40,27 +45,178 @@ void in_two_halves(Eigen::Index n, const std::function<void(Eigen::Index, Eigen:
   second.wait();
 }
 
+#if defined(__wasm_simd128__)
+// WebAssembly SIMD kernels for the basis products (issue 18: Eigen 3.4 has no wasm packet math, so
+// in wasm its products ran scalar): Qᵀ Y, Y −= Q P and Q S. Block widths are compile-time
+// constants so the sums stay in registers. Natively Eigen's own (AVX/SSE) products run.
+
+// P = Q(r0:r1, 0:m)ᵀ Y(r0:r1, :), two columns of Q at a time against a row-major copy of Y.
+template <int B>
+void project_rows_simd(const Eigen::MatrixXd& Q, int m, const Eigen::MatrixXd& Y, Eigen::Index r0, Eigen::Index r1,
+                       Eigen::MatrixXd& P) {
+  constexpr int L = B / 2;
+  const Eigen::Index rows = r1 - r0, ld = Q.outerStride();
+  std::vector<double> Yt(static_cast<size_t>(rows) * B);
+  for (int j = 0; j < B; ++j)
+    for (Eigen::Index r = 0; r < rows; ++r) Yt[r * B + j] = Y(r0 + r, j);
+  P.resize(m, B);
+  int i = 0;
+  for (; i + 1 < m; i += 2) {
+    v128_t a0[L], a1[L];
+    for (int l = 0; l < L; ++l) a0[l] = a1[l] = wasm_f64x2_splat(0.0);
+    const double* c0 = Q.data() + i * ld + r0;
+    const double* c1 = c0 + ld;
+    for (Eigen::Index r = 0; r < rows; ++r) {
+      const v128_t s0 = wasm_f64x2_splat(c0[r]), s1 = wasm_f64x2_splat(c1[r]);
+      const double* y = Yt.data() + r * B;
+      for (int l = 0; l < L; ++l) {
+        const v128_t yv = wasm_v128_load(y + 2 * l);
+        a0[l] = wasm_f64x2_add(a0[l], wasm_f64x2_mul(s0, yv));
+        a1[l] = wasm_f64x2_add(a1[l], wasm_f64x2_mul(s1, yv));
+      }
+    }
+    for (int l = 0; l < L; ++l) {
+      P(i, 2 * l) = wasm_f64x2_extract_lane(a0[l], 0), P(i, 2 * l + 1) = wasm_f64x2_extract_lane(a0[l], 1);
+      P(i + 1, 2 * l) = wasm_f64x2_extract_lane(a1[l], 0), P(i + 1, 2 * l + 1) = wasm_f64x2_extract_lane(a1[l], 1);
+    }
+  }
+  for (; i < m; ++i) {
+    v128_t a[L];
+    for (int l = 0; l < L; ++l) a[l] = wasm_f64x2_splat(0.0);
+    const double* c = Q.data() + i * ld + r0;
+    for (Eigen::Index r = 0; r < rows; ++r) {
+      const v128_t sv = wasm_f64x2_splat(c[r]);
+      for (int l = 0; l < L; ++l) a[l] = wasm_f64x2_add(a[l], wasm_f64x2_mul(sv, wasm_v128_load(Yt.data() + r * B + 2 * l)));
+    }
+    for (int l = 0; l < L; ++l) P(i, 2 * l) = wasm_f64x2_extract_lane(a[l], 0), P(i, 2 * l + 1) = wasm_f64x2_extract_lane(a[l], 1);
+  }
+}
+
+// out (rows by W, row-major) = Qt (rows by m, row-major) · Pt (m by W, row-major), two rows at a
+// time with the sums in registers.
+template <int W>
+void panel_times(const double* Qt, int m, Eigen::Index rows, const double* Pt, double* out) {
+  constexpr int L = W / 2;
+  Eigen::Index r = 0;
+  for (; r + 1 < rows; r += 2) {
+    v128_t a0[L], a1[L];
+    for (int l = 0; l < L; ++l) a0[l] = a1[l] = wasm_f64x2_splat(0.0);
+    const double* x0 = Qt + r * m;
+    const double* x1 = x0 + m;
+    for (int i = 0; i < m; ++i) {
+      const v128_t s0 = wasm_f64x2_splat(x0[i]), s1 = wasm_f64x2_splat(x1[i]);
+      const double* pr = Pt + i * W;
+      for (int l = 0; l < L; ++l) {
+        const v128_t pv = wasm_v128_load(pr + 2 * l);
+        a0[l] = wasm_f64x2_add(a0[l], wasm_f64x2_mul(s0, pv));
+        a1[l] = wasm_f64x2_add(a1[l], wasm_f64x2_mul(s1, pv));
+      }
+    }
+    for (int l = 0; l < L; ++l) {
+      wasm_v128_store(out + r * W + 2 * l, a0[l]);
+      wasm_v128_store(out + (r + 1) * W + 2 * l, a1[l]);
+    }
+  }
+  for (; r < rows; ++r)
+    for (int j = 0; j < W; ++j) {
+      double acc = 0;
+      for (int i = 0; i < m; ++i) acc += Qt[r * m + i] * Pt[i * W + j];
+      out[r * W + j] = acc;
+    }
+}
+
+// D(r0:r1, 0:p) = (or −=) Q(r0:r1, c0:c0+m) S (S: m by p). Q's rows are far apart in memory
+// (column-major, n rows), so each panel of 64 rows is first copied row-major (reading Q's columns
+// contiguously); S goes in row-major chunks of 8, 4 or 2 columns. D may be Q itself when the
+// written columns are read only through the panel copy (combine_in_place).
+void panel_product(const Eigen::MatrixXd& Q, int c0, int m, const Eigen::MatrixXd& S, Eigen::Index r0, Eigen::Index r1,
+                   bool subtract, double* D, Eigen::Index ldd) {
+  constexpr Eigen::Index kPanel = 64;
+  const Eigen::Index ld = Q.outerStride();
+  const int p = static_cast<int>(S.cols());
+  struct Chunk {
+    int j0, w;
+    std::vector<double> Pt;
+  };
+  std::vector<Chunk> chunks;
+  for (int j0 = 0; j0 < p;) {
+    const int w = p - j0 >= 8 ? 8 : p - j0 >= 4 ? 4 : p - j0 >= 2 ? 2 : 1;
+    Chunk c{j0, w, std::vector<double>(static_cast<size_t>(m) * w)};
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; j < w; ++j) c.Pt[i * w + j] = S(i, j0 + j);
+    chunks.push_back(std::move(c));
+    j0 += w;
+  }
+  std::vector<double> Qt(static_cast<size_t>(kPanel) * m), out(static_cast<size_t>(kPanel) * 8);
+  const double* q0 = Q.data() + c0 * ld;
+  for (Eigen::Index p0 = r0; p0 < r1; p0 += kPanel) {
+    const Eigen::Index rows = std::min(kPanel, r1 - p0);
+    for (int i = 0; i < m; ++i) {
+      const double* c = q0 + i * ld + p0;
+      for (Eigen::Index r = 0; r < rows; ++r) Qt[r * m + i] = c[r];
+    }
+    for (const Chunk& c : chunks) {
+      if (c.w == 8) panel_times<8>(Qt.data(), m, rows, c.Pt.data(), out.data());
+      else if (c.w == 4) panel_times<4>(Qt.data(), m, rows, c.Pt.data(), out.data());
+      else if (c.w == 2) panel_times<2>(Qt.data(), m, rows, c.Pt.data(), out.data());
+      else
+        for (Eigen::Index r = 0; r < rows; ++r) {
+          double acc = 0;
+          for (int i = 0; i < m; ++i) acc += Qt[r * m + i] * c.Pt[i];
+          out[r] = acc;
+        }
+      for (int j = 0; j < c.w; ++j) {
+        double* d = D + (c.j0 + j) * ldd + p0;
+        if (subtract)
+          for (Eigen::Index r = 0; r < rows; ++r) d[r] -= out[r * c.w + j];
+        else
+          for (Eigen::Index r = 0; r < rows; ++r) d[r] = out[r * c.w + j];
+      }
+    }
+  }
+}
+#endif
+
+// P = Q(r0:r1, 0:m)ᵀ Y(r0:r1, :).
+void project_rows(const Eigen::MatrixXd& Q, int m, const Eigen::MatrixXd& Y, Eigen::Index r0, Eigen::Index r1,
+                  Eigen::MatrixXd& P) {
+#if defined(__wasm_simd128__)
+  if (Y.cols() == 4) return project_rows_simd<4>(Q, m, Y, r0, r1, P);
+  if (Y.cols() == 8) return project_rows_simd<8>(Q, m, Y, r0, r1, P);
+#endif
+  P.noalias() = Q.block(r0, 0, r1 - r0, m).transpose() * Y.middleRows(r0, r1 - r0);
+}
+
+// Y(r0:r1, :) -= Q(r0:r1, c0:c0+m) P.
+void subtract_rows(const Eigen::MatrixXd& Q, int c0, int m, const Eigen::MatrixXd& P, Eigen::MatrixXd& Y,
+                   Eigen::Index r0, Eigen::Index r1) {
+#if defined(__wasm_simd128__)
+  return panel_product(Q, c0, m, P, r0, r1, true, Y.data(), Y.outerStride());
+#endif
+  Y.middleRows(r0, r1 - r0).noalias() -= Q.block(r0, c0, r1 - r0, m) * P;
+}
+
 // Qᵀ Y for the first m columns of Q, summed over the two row halves (the same order always).
 Eigen::MatrixXd project(const Eigen::MatrixXd& Q, int m, const Eigen::MatrixXd& Y) {
   Eigen::MatrixXd P[2];
-  in_two_halves(Q.rows(), [&](Eigen::Index b, Eigen::Index e) {
-    P[b == 0 ? 0 : 1].noalias() = Q.block(b, 0, e - b, m).transpose() * Y.middleRows(b, e - b);
-  });
+  in_two_halves(Q.rows(), [&](Eigen::Index b, Eigen::Index e) { project_rows(Q, m, Y, b, e, P[b == 0 ? 0 : 1]); });
   return P[0] + P[1];
 }
 
 // Y -= Q(:, c0 : c0 + m) P, by row halves.
 void subtract(const Eigen::MatrixXd& Q, int c0, int m, const Eigen::MatrixXd& P, Eigen::MatrixXd& Y) {
-  in_two_halves(Q.rows(), [&](Eigen::Index b, Eigen::Index e) {
-    Y.middleRows(b, e - b).noalias() -= Q.block(b, c0, e - b, m) * P;
-  });
+  in_two_halves(Q.rows(), [&](Eigen::Index b, Eigen::Index e) { subtract_rows(Q, c0, m, P, Y, b, e); });
 }
 
 // Q(:, 0:m) S by row halves.
 Eigen::MatrixXd combine(const Eigen::MatrixXd& Q, int m, const Eigen::MatrixXd& S) {
   Eigen::MatrixXd out(Q.rows(), S.cols());
   in_two_halves(Q.rows(), [&](Eigen::Index b, Eigen::Index e) {
+#if defined(__wasm_simd128__)
+    panel_product(Q, 0, m, S, b, e, false, out.data(), out.outerStride());
+#else
     out.middleRows(b, e - b).noalias() = Q.block(b, 0, e - b, m) * S;
+#endif
   });
   return out;
 }
@@ -69,14 +225,19 @@ Eigen::MatrixXd combine(const Eigen::MatrixXd& Q, int m, const Eigen::MatrixXd& 
 // needs only its own row of Q), so no n by p copy is held: at 52k vertices and k = 100 that copy
 // was 56 MB of the solve's peak.
 void combine_in_place(Eigen::MatrixXd& Q, int m, const Eigen::MatrixXd& S) {
-  constexpr Eigen::Index kPanel = 2048;
   in_two_halves(Q.rows(), [&](Eigen::Index b, Eigen::Index e) {
+#if defined(__wasm_simd128__)
+    // Each 64-row panel of Q is copied before its rows are overwritten.
+    panel_product(Q, 0, m, S, b, e, false, Q.data(), Q.outerStride());
+#else
+    constexpr Eigen::Index kPanel = 2048;
     Eigen::MatrixXd panel;
     for (Eigen::Index r = b; r < e; r += kPanel) {
       const Eigen::Index rows = std::min(kPanel, e - r);
       panel.noalias() = Q.block(r, 0, rows, m) * S;
       Q.block(r, 0, rows, S.cols()) = panel;
     }
+#endif
   });
 }
 
