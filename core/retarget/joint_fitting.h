@@ -22,7 +22,7 @@
 //  5b. each joint is then moved by the local affine map that takes the source surface around it
 //     (posed onto the fitted joints bone by bone) to its closest target points — a joint centred
 //     in a thigh stays centred in a thicker one; a few rounds, each move at most twice the
-//     joint's depth (measured: Knight's joints in Barbarian 0.78 → 0.59 % of the height);
+//     joint's depth (measured: Knight's joints in Barbarian 0.78 → 0.60 % of the height);
 //  6. a joint outside the target is pulled toward its skeleton point until inside; markers pin
 //     named joints and drag their chain neighbours (weights fall off over marker_reach joints).
 // Source joints outside the source surface (roots on the floor, IK targets) are not placed.
