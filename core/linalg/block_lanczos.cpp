@@ -191,9 +191,10 @@ void project_rows(const Eigen::MatrixXd& Q, int m, const Eigen::MatrixXd& Y, Eig
 void subtract_rows(const Eigen::MatrixXd& Q, int c0, int m, const Eigen::MatrixXd& P, Eigen::MatrixXd& Y,
                    Eigen::Index r0, Eigen::Index r1) {
 #if defined(__wasm_simd128__)
-  return panel_product(Q, c0, m, P, r0, r1, true, Y.data(), Y.outerStride());
-#endif
+  panel_product(Q, c0, m, P, r0, r1, true, Y.data(), Y.outerStride());
+#else
   Y.middleRows(r0, r1 - r0).noalias() -= Q.block(r0, c0, r1 - r0, m) * P;
+#endif
 }
 
 // Qᵀ Y for the first m columns of Q, summed over the two row halves (the same order always).

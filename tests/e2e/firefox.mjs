@@ -195,9 +195,7 @@ export class PlaywrightLikePage {
   close() { return this.page.close(); }
 }
 
-// Runs `tests` ([{name, fn}]) in Firefox against baseUrl. `extra` are added to each test's
-// arguments. Returns {passed, failed, version}; prints one line per test like run.mjs.
-// Resolves with fn()'s value or with `fallback` after ms (a wedged browser must not hang us).
+// Resolves with the promise's value, or with `fallback` after ms (a wedged browser must not hang us).
 const within = (promise, ms, fallback) => Promise.race([promise, sleep(ms).then(() => fallback)]);
 
 // What the page shows when it is not ready: enough to tell a slow start from a wedged one.
