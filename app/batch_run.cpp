@@ -301,11 +301,19 @@ BatchRunResult run_batch(const BatchManifest& m, const BatchRunOptions& opt, con
   std::vector<const BatchJob*> runnable;
   for (const BatchJob* j : to_run) {
     const fs::path op(j->output);
-    if (op.has_parent_path() && !fs::is_directory(op.parent_path(), ec) && !fs::create_directories(op.parent_path(), ec)) {
-      BatchJobOutcome& o = outcomes[j->index];
-      o.status = "failed";
-      o.message = "[IoError] cannot create the folder '" + io::quote_input(op.parent_path().string(), 200) + "'";
-      continue;
+    // create_directories returns false when the folder already exists, which happens when another
+    // process (a Slurm task of the same array) made it between the two calls: the folder being
+    // there afterwards is what counts.
+    if (op.has_parent_path()) {
+      std::error_code mk;
+      fs::create_directories(op.parent_path(), mk);
+      if (!fs::is_directory(op.parent_path(), ec)) {
+        BatchJobOutcome& o = outcomes[j->index];
+        o.status = "failed";
+        o.message = "[IoError] cannot create the folder '" + io::quote_input(op.parent_path().string(), 200) + "'" +
+                    (mk ? " (" + mk.message() + ")" : std::string());
+        continue;
+      }
     }
     runnable.push_back(j);
   }

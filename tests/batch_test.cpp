@@ -601,11 +601,15 @@ TEST(BatchRun, SlurmScriptsRunByHandEqualTheLocalRun) {
   EXPECT_NE(array.find("#SBATCH --array=0-1"), std::string::npos) << array;
   EXPECT_NE(array.find("--shard \"${SLURM_ARRAY_TASK_ID}/2\""), std::string::npos) << array;
   EXPECT_NE(read_text(dir + "/out/summary.slurm-submit.sh").find("--dependency=afterany:"), std::string::npos);
-  for (int i = 0; i < 2; ++i) {
-    const std::string cmd = "cd '" + dir + "' && SLURM_ARRAY_TASK_ID=" + std::to_string(i) +
-                            " SLURM_CPUS_PER_TASK=1 bash out/summary.slurm-array.sh >/dev/null 2>&1";
-    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-  }
+  // Both tasks at once, as Slurm starts them: they race to create the same output folders (the
+  // seventeenth submission's CI failure: one task found out/retarget/Fox missing, the other made it,
+  // and create_directories' "nothing created" was taken for a failure).
+  std::string cmd = "cd '" + dir + "' || exit 1; ";
+  for (int i = 0; i < 2; ++i)
+    cmd += "(SLURM_ARRAY_TASK_ID=" + std::to_string(i) + " SLURM_CPUS_PER_TASK=1 bash out/summary.slurm-array.sh >task" +
+           std::to_string(i) + ".txt 2>&1) & p" + std::to_string(i) + "=$!; ";
+  cmd += "wait $p0 && wait $p1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd << read_text(dir + "/task0.txt") << read_text(dir + "/task1.txt");
   ASSERT_EQ(std::system(("cd '" + dir + "' && bash out/summary.slurm-gather.sh >/dev/null 2>&1").c_str()), 0);
   const Json gathered = summary_of(dir);
   EXPECT_EQ(count_status(gathered, "ok"), 9);
