@@ -306,6 +306,9 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     await openJob(page);
     await page.setInputFiles('#rt-source-file', path.join(repoDir, 'data/anim/CesiumMan/CesiumMan.glb'));
     await page.waitForFunction(() => window.__meshmorph.state.retarget.source?.id === 'file', null, { timeout: 60000 });
+    // Its one clip is chosen without a click (nothing to pick), and listed as selected.
+    const one = await page.evaluate(() => ({ clip: window.__meshmorph.state.retarget.source.clip, selected: document.querySelector('#rt-clip').value }));
+    check(one.clip === 0 && one.selected === '0', `CesiumMan's only clip was not chosen: ${JSON.stringify(one)}`);
     await page.setInputFiles('#rt-target-file', path.join(repoDir, 'data/anim/human_woman.ply'));
     await page.waitForFunction(() => window.__meshmorph.state.retarget.target?.id === 'file', null, { timeout: 60000 });
     await waitIdle(page);

@@ -349,6 +349,12 @@ export const panel = {
         chooseJoints();
       }
       refresh();
+      // One clip: nothing to pick, so it is chosen (its preview plays, and the run starts once
+      // a target is there).
+      if (clips.length === 1 && clipOption(clips, 0) != null) {
+        chooseClip(0);
+        $('rt-clip').value = '0';
+      }
     }
 
     function showClips() {
