@@ -34,6 +34,8 @@ const OptionSchema<JointsJobOptions>& joints_options() {
               "rounds of moving each joint by the local affine map of the source surface around it onto the target (0 = off)");
     s.number("surface_refine_sigma", [](O& o) -> double& { return o.fit.surface_refine_sigma; }, 0.1, 10,
              "that neighbourhood: Gaussian sigma = this x the joint's depth below the source surface");
+    s.number("skeleton_prior", [](O& o) -> double& { return o.fit.skeleton_prior; }, 0, 100,
+             "weight of the source's bone vectors (scaled to the target) against the fitted joints (0 = off)");
     s.integer("marker_reach", [](O& o) -> int& { return o.fit.marker_reach; }, 0, 100,
               "markers also move joints up to this many bones away");
     s.boolean("check_topology", [](O& o) -> bool& { return o.fit.check_topology; },

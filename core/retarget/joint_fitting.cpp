@@ -863,6 +863,33 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     }
   }
 
+  // 5c. Skeleton prior: every bone of the fit pulled toward the source's bone carried by the
+  // global similarity (scale H_t/H_s, rotation R), least squares against the fitted positions:
+  //   min Σ_j |p_j − p̂_j|² + w Σ_(c,p) |(p_c − p_p) − b_cp|²
+  // (the proportions-and-directions term of skeleton embedding, Baran & Popović 2007). A self fit
+  // is unchanged (p̂ = source joints, b = their bones).
+  if (opt.skeleton_prior > 0 && out.size() > 1) {
+    const int n = out.size();
+    std::vector<int> src_of(n, -1);
+    for (int j : used)
+      if (out_index[j] >= 0) src_of[out_index[j]] = j;
+    Eigen::MatrixXd A = Eigen::MatrixXd::Identity(n, n), B = out.P;
+    const double w = opt.skeleton_prior;
+    for (int k = 0; k < n; ++k) {
+      const int q = out.parent[k];
+      if (q < 0) continue;
+      const Eigen::Vector3d b =
+          R.transpose() * ((ft.H / fs.H) * (source_joints.P.row(src_of[k]) - source_joints.P.row(src_of[q])).transpose());
+      A(k, k) += w, A(q, q) += w, A(k, q) -= w, A(q, k) -= w;
+      B.row(k) += w * b.transpose();
+      B.row(q) -= w * b.transpose();
+    }
+    const Eigen::MatrixXd P = A.ldlt().solve(B);
+    for (int k = 0; k < n; ++k)
+      if (P.row(k).allFinite() && inside_t(P.row(k).transpose()) && std::find(outside.begin(), outside.end(), out.names[k]) == outside.end())
+        out.P.row(k) = P.row(k);
+  }
+
   // Markers: pin, and drag chain neighbours within marker_reach bones.
   if (!markers.empty()) {
     std::vector<int> pinned(out.size(), 0);

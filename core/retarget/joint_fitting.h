@@ -78,6 +78,7 @@ struct JointFitOptions {
   double surface_refine_sigma = 2.5; // its neighbourhood: Gaussian σ = this × the joint's depth below the source surface
   double surface_refine_ridge = 0.1; // its affine fit's ridge toward a pure translation, × the neighbourhood's spread
   double surface_refine_max_move = 2;// a joint moves at most this × its depth inside the target (≥ 0.01 × height)
+  double skeleton_prior = 0;       // step 5c: weight of the source's bones (carried by the global similarity) against the fit
   int marker_reach = 3;           // markers move unpinned joints up to this many bones away (0 = only pin)
   bool check_topology = true;     // refuse a mismatch (step 4); false = fit whatever matches
 };
