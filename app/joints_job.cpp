@@ -35,7 +35,9 @@ const OptionSchema<JointsJobOptions>& joints_options() {
     s.number("surface_refine_sigma", [](O& o) -> double& { return o.fit.surface_refine_sigma; }, 0.1, 10,
              "that neighbourhood: Gaussian sigma = this x the joint's depth below the source surface");
     s.number("skeleton_prior", [](O& o) -> double& { return o.fit.skeleton_prior; }, 0, 100,
-             "weight of the source's bone vectors (scaled to the target) against the fitted joints (0 = off)");
+             "weight of the source's bones (scaled to the target) against the fitted joints, for a target of the source's rig family (0 = off)");
+    s.number("skeleton_prior_agreement", [](O& o) -> double& { return o.fit.skeleton_prior_agreement; }, 0, 10,
+             "the prior is used in full while the fitted bones differ from the source's by at most this (relative), and not at all beyond 1.6 x this");
     s.integer("marker_reach", [](O& o) -> int& { return o.fit.marker_reach; }, 0, 100,
               "markers also move joints up to this many bones away");
     s.boolean("check_topology", [](O& o) -> bool& { return o.fit.check_topology; },

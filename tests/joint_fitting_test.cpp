@@ -538,25 +538,19 @@ void jf_knight_on_barbarian(const std::string& joints, bool base, double* et, do
 
 TEST(JointFittingRetarget, AutoJointsWithinATquarterOfTrueJoints) {
   // Knight → Barbarian against Barbarian's own Walking_A, and self-retargeting of the Knight.
-  // The paper's maps alone (articulated base off) — the 1.25× of issue 14: measured true 0.0219,
-  // auto 0.0237 (1.08×). With the articulated base (the default since the fifteenth session) the
-  // bones pivot at the fitted joints, so joint placement matters more. The true joints' run treats
-  // the Barbarian as unrigged too (its own skin's weights off, as with automatic joints): true
-  // 0.0049, auto 0.0071 (1.45×, NOT within 1.25×; 0.0087 before the surface refinement, step 5b;
-  // with its own skin the true joints give 0.0024) — still well below the paper's maps with the
-  // true joints (docs/retarget.md: which joints the rest comes from).
+  // The true joints' run treats the Barbarian as unrigged too (its own skin's weights off, as with
+  // automatic joints). Measured with the articulated base (the default): true 0.0049, automatic
+  // 0.0058 (1.19×; 1.45× without the skeleton prior of step 5c, 1.79× before step 5b); the
+  // paper's maps alone: true 0.0219, automatic 0.0220. With its own skin the true joints give
+  // 0.0024 (docs/retarget.md).
   for (const bool base : {false, true}) {
     double et = 0, ea = 0;
     ASSERT_NO_FATAL_FAILURE(jf_knight_on_barbarian("auto", base, &et, &ea));
     std::cout << "[ Knight -> Barbarian vs own clip, articulated base " << base << " ] true joints " << et
               << ", auto joints " << ea << " of height\n";
-    if (!base) {
-      RecordProperty("knight_barbarian_true", std::to_string(et));
-      RecordProperty("knight_barbarian_auto", std::to_string(ea));
-      EXPECT_LE(ea, 1.25 * et);
-    } else {
-      EXPECT_LE(ea, 0.0085);  // measured 0.0071
-    }
+    RecordProperty(base ? "knight_barbarian_true" : "knight_barbarian_true_maps_alone", std::to_string(et));
+    RecordProperty(base ? "knight_barbarian_auto" : "knight_barbarian_auto_maps_alone", std::to_string(ea));
+    EXPECT_LE(ea, 1.25 * et) << "articulated base " << base;
   }
   for (const char* c : {"anim/KayKit/Knight.glb", "anim/CesiumMan/CesiumMan.glb"}) {
     auto truej = jf_job(c, c, "", true, false);  // unrigged on both sides (see above)
@@ -571,33 +565,45 @@ TEST(JointFittingRetarget, AutoJointsWithinATquarterOfTrueJoints) {
   }
 }
 
-// Step 5c, the skeleton prior (an option, off by default): the fitted bones pulled toward the
-// source's bones scaled into the target. KayKit's Knight and Barbarian share one rig (their rest
-// joints are identical), so the prior is close to the truth there: with weight 2 the Knight →
-// unrigged Barbarian retarget comes within issue 14's 1.25× of the true joints (measured 0.0058
-// vs 0.0049, 1.19×; 1.45× without). It is not the default because it costs the Fox → wolf0
-// clip bone-length error (0.0104 → 0.0119, hand-placed 0.0095; docs/retarget.md step 5c).
-TEST(JointFittingRetarget, SkeletonPriorBringsASameRigTargetWithinAQuarter) {
-  const mm::io::LoadResult knight = mm::io::load_asset(mm::test::data_path("anim/KayKit/Knight.glb"));
-  const mm::io::LoadResult barb = mm::io::load_asset(mm::test::data_path("anim/KayKit/Barbarian.glb"));
-  ASSERT_TRUE(knight.status.ok() && barb.status.ok());
+// Step 5c, the skeleton prior: used where the fitted skeleton already agrees with the source's
+// (same rig family: KayKit's Knight and Barbarian share one rig, their rest joints are identical),
+// left out where it does not (a fox's proportions in a wolf, CesiumMan's in a woman), where it
+// raised the Fox → wolf0 clip's bone-length error past the hand-placed joints' (0.0104 → 0.0119
+// at weight 2; docs/retarget.md). Turned off, the Knight → Barbarian retarget is 1.45× the true
+// joints' error again.
+TEST(JointFittingRetarget, SkeletonPriorOnlyForTheSourcesRigFamily) {
+  const JfCharacter knight = jf_character("anim/KayKit/Knight.glb"), barb = jf_character("anim/KayKit/Barbarian.glb"),
+                    fox = jf_character("anim/Fox/glTF-Binary/Fox.glb");
+  const mm::io::LoadResult wolf = mm::io::load_asset(mm::test::data_path("anim/wolf0.ply"));
+  const mm::io::LoadResult woman = mm::io::load_asset(mm::test::data_path("anim/human_woman.ply"));
+  const JfCharacter cesium = jf_character("anim/CesiumMan/CesiumMan.glb");
+  ASSERT_TRUE(wolf.status.ok() && woman.status.ok());
+  mm::JointFitOptions gltf;
+  gltf.target_up = 1, gltf.target_front = 2;
+  const mm::JointFitResult kb = mm::fit_joints(knight.c.V_rest, knight.c.F, knight.joints, barb.c.V_rest, barb.c.F, {}, gltf);
+  const mm::JointFitResult fw = mm::fit_joints(fox.c.V_rest, fox.c.F, fox.joints, wolf.asset.V_raw, wolf.asset.F_raw);
+  const mm::JointFitResult cw = mm::fit_joints(cesium.c.V_rest, cesium.c.F, cesium.joints, woman.asset.V_raw, woman.asset.F_raw);
+  for (const auto* f : {&kb, &fw, &cw}) ASSERT_TRUE(f->status.ok()) << f->status.message;
+  std::cout << "[ bones' disagreement with the source's ] Knight in Barbarian " << kb.skeleton_agreement << " (prior "
+            << kb.skeleton_prior_used << "), Fox in wolf0 " << fw.skeleton_agreement << " (" << fw.skeleton_prior_used
+            << "), CesiumMan in the woman " << cw.skeleton_agreement << " (" << cw.skeleton_prior_used << ")\n";
+  EXPECT_LT(kb.skeleton_agreement, 0.15);
+  EXPECT_EQ(kb.skeleton_prior_used, 2);
+  EXPECT_EQ(fw.skeleton_prior_used, 0);
+  EXPECT_EQ(cw.skeleton_prior_used, 0);
+  // Off: the same retarget as AutoJointsWithinATquarterOfTrueJoints, from the joints job's JSON.
+  const mm::io::LoadResult k = mm::io::load_asset(mm::test::data_path("anim/KayKit/Knight.glb"));
+  const mm::io::LoadResult b = mm::io::load_asset(mm::test::data_path("anim/KayKit/Barbarian.glb"));
+  ASSERT_TRUE(k.status.ok() && b.status.ok());
   mm::app::JointsJobOptions jo;
-  jo.fit.skeleton_prior = 2;
-  const mm::app::JointsJobResult fit = mm::app::run_joints_job(knight.asset, barb.asset, "", jo);
-  ASSERT_TRUE(fit.status.ok()) << fit.status.message;
-  double et = 0, ep = 0;
-  ASSERT_NO_FATAL_FAILURE(jf_knight_on_barbarian(fit.json, true, &et, &ep));
-  std::cout << "[ Knight -> unrigged Barbarian, skeleton prior 2 ] true joints " << et << ", automatic joints " << ep
-            << " of height (" << ep / et << "x)\n";
-  EXPECT_LE(ep, 1.25 * et);
-  // A self fit stays exact with the prior on (the source's bones are the fit's).
-  const mm::app::JointsJobResult self = mm::app::run_joints_job(knight.asset, knight.asset, "", jo);
-  ASSERT_TRUE(self.status.ok()) << self.status.message;
-  const mm::io::JointSetResult sj = mm::io::parse_joints_json(self.json);
-  ASSERT_TRUE(sj.status.ok());
-  const JfCharacter kc = jf_character("anim/KayKit/Knight.glb");
-  const JfError e = jf_joint_error(sj.joints, kc.joints, jf_extent(kc.c.V_rest, 1));
-  EXPECT_LE(e.mean, 1e-9);
+  jo.fit.skeleton_prior = 0;
+  const mm::app::JointsJobResult off = mm::app::run_joints_job(k.asset, b.asset, "", jo);
+  ASSERT_TRUE(off.status.ok()) << off.status.message;
+  double et = 0, eo = 0;
+  ASSERT_NO_FATAL_FAILURE(jf_knight_on_barbarian(off.json, true, &et, &eo));
+  std::cout << "[ Knight -> unrigged Barbarian, skeleton prior off ] true joints " << et << ", automatic joints " << eo << " ("
+            << eo / et << "x)\n";
+  EXPECT_GT(eo, 1.3 * et);
 }
 
 TEST(JointFittingRetarget, StaticTargetsBoneLengthsNoWorseThanHandPlaced) {

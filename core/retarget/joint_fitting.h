@@ -78,7 +78,9 @@ struct JointFitOptions {
   double surface_refine_sigma = 2.5; // its neighbourhood: Gaussian σ = this × the joint's depth below the source surface
   double surface_refine_ridge = 0.1; // its affine fit's ridge toward a pure translation, × the neighbourhood's spread
   double surface_refine_max_move = 2;// a joint moves at most this × its depth inside the target (≥ 0.01 × height)
-  double skeleton_prior = 0;       // step 5c: weight of the source's bones (carried by the global similarity) against the fit
+  double skeleton_prior = 2;       // step 5c: weight of the source's bones (scaled into the target) against the fit (0 = off)
+  double skeleton_prior_agreement = 0.15;  // ... full while the fitted bones differ from those by ≤ this (Σ|d − b| / Σ|b|),
+                                   // fading to 0 at 1.6 × this (a target of the source's rig family)
   int marker_reach = 3;           // markers move unpinned joints up to this many bones away (0 = only pin)
   bool check_topology = true;     // refuse a mismatch (step 4); false = fit whatever matches
 };
@@ -99,6 +101,8 @@ struct JointFitResult {
   int target_up = 1;              // detected or given up axis of the target (as JointFitOptions)
   std::vector<std::pair<int, int>> limb_ends;  // matched leaves (source node, target node)
   int source_ground = 0, target_ground = 0;    // limb ends on the ground (step 4)
+  double skeleton_agreement = 0;  // step 5c: Σ|d − b| / Σ|b| of the fitted bones d against the source's b
+  double skeleton_prior_used = 0; // the prior's weight after that gate (0: not applied)
 };
 
 // Vs/Fs: source rest surface; source_joints: its joints (names, positions, parents).

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 
@@ -261,7 +262,13 @@ int run_joints(const std::vector<std::string>& argv) {
             << " source joints outside the source surface skipped) in " << static_cast<int>(ms) << " ms; skeletons "
             << fit.source_skeleton.size() << " / " << fit.target_skeleton.size() << " nodes, limb ends "
             << fit.source_skeleton.leaves().size() << " / " << fit.target_skeleton.leaves().size() << " ("
-            << fit.limb_ends.size() << " matched), target up axis " << fit.target_up << "\n  wrote " << out_path << "\n";
+            << fit.limb_ends.size() << " matched), target up axis " << fit.target_up << "\n  skeleton prior "
+            << std::setprecision(3);
+  if (fit.skeleton_prior_used > 0)
+    std::cout << "weight " << fit.skeleton_prior_used;
+  else
+    std::cout << "not used";
+  std::cout << " (the fitted bones differ from the source's by " << fit.skeleton_agreement << ")\n  wrote " << out_path << "\n";
   if (!debug_path.empty()) std::cout << "  wrote " << debug_path << "\n";
   return 0;
 }
