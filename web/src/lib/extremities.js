@@ -144,7 +144,7 @@ function largestPartVertex(graph) {
 // → {centre, radius (largest distance from the centre), extremities: [{vertex, relative,
 //    direction: [x, y, z] unit}], between: geodesic distances between the extremities / radius
 //    (row-major n × n)}
-export function findExtremities(positions, triangles, { count = 8, minRelative = 0.35, separation = 0.25 } = {}) {
+export function findExtremities(positions, triangles, { count = 8, minRelative = 0.35, separation = 0.25, bulkRadius = 0.2 } = {}) {
   const graph = edgeGraph(positions, triangles);
   const start = largestPartVertex(graph);
   const a = argmax(dijkstra(graph, [start]));
@@ -176,6 +176,26 @@ export function findExtremities(positions, triangles, { count = 8, minRelative =
     const norm = Math.hypot(...d) || 1;
     extremities.push({ vertex: v, relative: dc[v] / radius, direction: d.map((x) => x / norm) });
   }
+  // Bulk: the share of the surface within `bulkRadius` × radius of each extremity (a head is
+  // bulkier than a paw whatever the pose; geodesic, so the pose does not change it).
+  const area = new Float64Array(graph.count);
+  let total = 0;
+  for (let t = 0; t + 2 < triangles.length; t += 3) {
+    const [a, b, c] = [triangles[t], triangles[t + 1], triangles[t + 2]];
+    const u = [0, 1, 2].map((k) => positions[3 * b + k] - positions[3 * a + k]);
+    const w = [0, 1, 2].map((k) => positions[3 * c + k] - positions[3 * a + k]);
+    const A = 0.5 * Math.hypot(u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]);
+    area[a] += A / 3;
+    area[b] += A / 3;
+    area[c] += A / 3;
+    total += A;
+  }
+  for (const e of extremities) {
+    const d = dijkstra(graph, [e.vertex], { maxDistance: bulkRadius * radius });
+    let sum = 0;
+    for (let v = 0; v < graph.count; ++v) if (Number.isFinite(d[v])) sum += area[v];
+    e.bulk = total > 0 ? sum / total : 0;
+  }
   const n = extremities.length;
   const between = new Array(n * n).fill(0);
   extremities.forEach((e, i) => {
@@ -186,31 +206,54 @@ export function findExtremities(positions, triangles, { count = 8, minRelative =
 }
 
 // Pairs of extremities of two meshes (findExtremities results): [{reference, source, cost}]
-// (vertex indices), cheapest first, each extremity in at most one pair. Then the pairs must
-// agree with each other intrinsically: the pair whose geodesic distances to the other pairs'
-// ends differ most between the meshes (mean relative difference over `maxDistortion`) is
+// (vertex indices), each extremity in at most one pair. The assignment is chosen as a whole,
+// by what does not change with the pose: every pair costs the difference of its ends' relative
+// distances from the centre plus the mean difference of its geodesic distances to the other
+// pairs' ends (`between`); the directions from the centre only break ties (mirror-symmetric
+// limbs: left vs right), with a small weight, since a posed reference (a lion standing up, paws
+// raised) points its limbs elsewhere. An extremity left unpaired costs `unpaired`. Exhaustive
+// over partial injective maps (≤ 8 extremities a side: ~1.4M assignments at most). Then the
+// pairs must agree with each other intrinsically: the pair whose geodesic distances to the other
+// pairs' ends differ most between the meshes (mean relative difference over `maxDistortion`) is
 // dropped, until all agree.
-export function matchExtremities(referenceSet, sourceSet, { maxCost = 0.9, maxDistortion = 0.2 } = {}) {
+export function matchExtremities(referenceSet, sourceSet, { maxDistortion = 0.2, direction = 0.15, unpaired = 0.7, bulk = 0.4 } = {}) {
   const reference = referenceSet.extremities;
   const source = sourceSet.extremities;
-  const costs = [];
-  reference.forEach((r, i) => source.forEach((s, j) => {
-    const direction = Math.hypot(r.direction[0] - s.direction[0], r.direction[1] - s.direction[1], r.direction[2] - s.direction[2]);
-    costs.push({ i, j, cost: Math.abs(r.relative - s.relative) + 0.5 * direction });
-  }));
-  costs.sort((x, y) => x.cost - y.cost);
-  const usedR = new Set();
-  const usedS = new Set();
-  const pairs = [];
-  for (const { i, j, cost } of costs) {
-    if (cost > maxCost) break;
-    if (usedR.has(i) || usedS.has(j)) continue;
-    usedR.add(i);
-    usedS.add(j);
-    pairs.push({ i, j, reference: reference[i].vertex, source: source[j].vertex, cost });
-  }
   const nr = reference.length;
   const ns = source.length;
+  const unary = (i, j) => {
+    const r = reference[i].direction;
+    const t = source[j].direction;
+    const b = reference[i].bulk > 0 && source[j].bulk > 0 ? Math.abs(Math.log(reference[i].bulk / source[j].bulk)) : 0;
+    return Math.abs(reference[i].relative - source[j].relative) + bulk * b + direction * Math.hypot(r[0] - t[0], r[1] - t[1], r[2] - t[2]);
+  };
+  const delta = (i, j, k, l) => Math.abs(referenceSet.between[i * nr + k] - sourceSet.between[j * ns + l]);
+  const ri = [];
+  const sj = [];
+  const usedS = new Uint8Array(ns);
+  let best = { cost: unpaired * Math.min(nr, ns), ri: [], sj: [] };
+  const search = (i, unarySum, pairSum) => {
+    const m = ri.length;
+    const cost = unarySum + (m > 1 ? (2 * pairSum) / (m - 1) : 0) + unpaired * (Math.min(nr, ns) - m);
+    if (cost < best.cost - 1e-12) best = { cost, ri: ri.slice(), sj: sj.slice() };
+    if (i >= nr || m >= Math.min(nr, ns)) return;
+    search(i + 1, unarySum, pairSum); // reference extremity i unpaired
+    for (let j = 0; j < ns; ++j) {
+      if (usedS[j]) continue;
+      let add = 0;
+      for (let q = 0; q < m; ++q) add += delta(i, j, ri[q], sj[q]);
+      usedS[j] = 1;
+      ri.push(i);
+      sj.push(j);
+      search(i + 1, unarySum + unary(i, j), pairSum + add);
+      ri.pop();
+      sj.pop();
+      usedS[j] = 0;
+    }
+  };
+  search(0, 0, 0);
+  const pairs = best.ri.map((i, k) => ({ i, j: best.sj[k], reference: reference[i].vertex, source: source[best.sj[k]].vertex, cost: unary(i, best.sj[k]) }));
+  pairs.sort((x, y) => x.cost - y.cost);
   for (;;) {
     if (pairs.length < 3) break;
     let worst = -1;
