@@ -217,10 +217,11 @@ export function findExtremities(positions, triangles, { count = 8, minRelative =
 // pairs' ends differ most between the meshes (mean relative difference over `maxDistortion`) is
 // dropped, until all agree.
 export function matchExtremities(referenceSet, sourceSet, { maxDistortion = 0.2, direction = 0.15, unpaired = 0.7, bulk = 0.4 } = {}) {
-  const reference = referenceSet.extremities;
-  const source = sourceSet.extremities;
-  const nr = reference.length;
-  const ns = source.length;
+  // The search is exhaustive: at most the 8 farthest extremities of each side take part.
+  const reference = referenceSet.extremities.slice(0, 8);
+  const source = sourceSet.extremities.slice(0, 8);
+  const nr = referenceSet.extremities.length;
+  const ns = sourceSet.extremities.length;
   const unary = (i, j) => {
     const r = reference[i].direction;
     const t = source[j].direction;
@@ -230,15 +231,15 @@ export function matchExtremities(referenceSet, sourceSet, { maxDistortion = 0.2,
   const delta = (i, j, k, l) => Math.abs(referenceSet.between[i * nr + k] - sourceSet.between[j * ns + l]);
   const ri = [];
   const sj = [];
-  const usedS = new Uint8Array(ns);
-  let best = { cost: unpaired * Math.min(nr, ns), ri: [], sj: [] };
+  const usedS = new Uint8Array(source.length);
+  let best = { cost: unpaired * Math.min(reference.length, source.length), ri: [], sj: [] };
   const search = (i, unarySum, pairSum) => {
     const m = ri.length;
-    const cost = unarySum + (m > 1 ? (2 * pairSum) / (m - 1) : 0) + unpaired * (Math.min(nr, ns) - m);
+    const cost = unarySum + (m > 1 ? (2 * pairSum) / (m - 1) : 0) + unpaired * (Math.min(reference.length, source.length) - m);
     if (cost < best.cost - 1e-12) best = { cost, ri: ri.slice(), sj: sj.slice() };
-    if (i >= nr || m >= Math.min(nr, ns)) return;
+    if (i >= reference.length || m >= Math.min(reference.length, source.length)) return;
     search(i + 1, unarySum, pairSum); // reference extremity i unpaired
-    for (let j = 0; j < ns; ++j) {
+    for (let j = 0; j < source.length; ++j) {
       if (usedS[j]) continue;
       let add = 0;
       for (let q = 0; q < m; ++q) add += delta(i, j, ri[q], sj[q]);
