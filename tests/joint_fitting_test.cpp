@@ -591,6 +591,13 @@ TEST(JointFittingRetarget, SkeletonPriorOnlyForTheSourcesRigFamily) {
   EXPECT_EQ(kb.skeleton_prior_used, 2);
   EXPECT_EQ(fw.skeleton_prior_used, 0);
   EXPECT_EQ(cw.skeleton_prior_used, 0);
+  // The person is told when the prior was used (a note among the fit's warnings), and only then.
+  const auto says_prior = [](const mm::JointFitResult& f) {
+    return std::any_of(f.warnings.begin(), f.warnings.end(), [](const std::string& w) { return w.find("used as a prior") != std::string::npos; });
+  };
+  EXPECT_TRUE(says_prior(kb));
+  EXPECT_FALSE(says_prior(fw));
+  EXPECT_FALSE(says_prior(cw));
   // Off: the same retarget as AutoJointsWithinATquarterOfTrueJoints, from the joints job's JSON.
   const mm::io::LoadResult k = mm::io::load_asset(mm::test::data_path("anim/KayKit/Knight.glb"));
   const mm::io::LoadResult b = mm::io::load_asset(mm::test::data_path("anim/KayKit/Barbarian.glb"));

@@ -892,6 +892,14 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     r.skeleton_agreement = rel;
     const double w = opt.skeleton_prior * std::clamp((1.6 * a - rel) / (0.6 * a), 0.0, 1.0);
     r.skeleton_prior_used = w;
+    if (w > 0 && rel > 1e-9) {
+      char note[200];
+      std::snprintf(note, sizeof note,
+                    "the source's skeleton was used as a prior (weight %.2g): the fitted bones differ from the source's by %.0f %%, "
+                    "as within one rig family (option skeleton_prior 0 turns this off)",
+                    w, 100 * rel);
+      r.warnings.push_back(note);
+    }
     if (w > 0) {
       Eigen::MatrixXd A = Eigen::MatrixXd::Identity(n, n), B = out.P;
       for (const auto& [k, b] : bones) {
