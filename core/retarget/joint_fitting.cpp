@@ -890,7 +890,8 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     }
     const double a = opt.skeleton_prior_agreement, rel = len > 0 ? dev / len : 0;
     r.skeleton_agreement = rel;
-    const double w = opt.skeleton_prior * std::clamp((1.6 * a - rel) / (0.6 * a), 0.0, 1.0);
+    const double gate = a > 0 ? std::clamp((1.6 * a - rel) / (0.6 * a), 0.0, 1.0) : (rel <= 0 ? 1.0 : 0.0);
+    const double w = opt.skeleton_prior * gate;
     r.skeleton_prior_used = w;
     if (w > 0 && rel > 1e-9) {
       char note[200];
