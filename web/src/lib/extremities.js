@@ -176,31 +176,32 @@ export function findExtremities(positions, triangles, { count = 8, minRelative =
     const norm = Math.hypot(...d) || 1;
     extremities.push({ vertex: v, relative: dc[v] / radius, direction: d.map((x) => x / norm) });
   }
-  // Bulk: the share of the surface within `bulkRadius` × radius of each extremity (a head is
-  // bulkier than a paw whatever the pose; geodesic, so the pose does not change it).
+  // Vertex areas (a third of each incident triangle) for the bulk below.
   const area = new Float64Array(graph.count);
   let total = 0;
   for (let t = 0; t + 2 < triangles.length; t += 3) {
-    const [a, b, c] = [triangles[t], triangles[t + 1], triangles[t + 2]];
-    const u = [0, 1, 2].map((k) => positions[3 * b + k] - positions[3 * a + k]);
-    const w = [0, 1, 2].map((k) => positions[3 * c + k] - positions[3 * a + k]);
-    const A = 0.5 * Math.hypot(u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]);
-    area[a] += A / 3;
-    area[b] += A / 3;
-    area[c] += A / 3;
+    const a = 3 * triangles[t];
+    const b = 3 * triangles[t + 1];
+    const c = 3 * triangles[t + 2];
+    const ux = positions[b] - positions[a], uy = positions[b + 1] - positions[a + 1], uz = positions[b + 2] - positions[a + 2];
+    const wx = positions[c] - positions[a], wy = positions[c + 1] - positions[a + 1], wz = positions[c + 2] - positions[a + 2];
+    const A = 0.5 * Math.hypot(uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx);
+    area[a / 3] += A / 3;
+    area[b / 3] += A / 3;
+    area[c / 3] += A / 3;
     total += A;
   }
-  for (const e of extremities) {
-    const d = dijkstra(graph, [e.vertex], { maxDistance: bulkRadius * radius });
-    let sum = 0;
-    for (let v = 0; v < graph.count; ++v) if (Number.isFinite(d[v])) sum += area[v];
-    e.bulk = total > 0 ? sum / total : 0;
-  }
+  // One Dijkstra per extremity gives both its geodesic distances to the others and its bulk: the
+  // share of the surface within `bulkRadius` × radius of it (a head is bulkier than a paw
+  // whatever the pose; geodesic, so the pose does not change it).
   const n = extremities.length;
   const between = new Array(n * n).fill(0);
   extremities.forEach((e, i) => {
     const d = dijkstra(graph, [e.vertex]);
     extremities.forEach((f, j) => { between[i * n + j] = d[f.vertex] / radius; });
+    let sum = 0;
+    for (let v = 0; v < graph.count; ++v) if (d[v] <= bulkRadius * radius) sum += area[v];
+    e.bulk = total > 0 ? sum / total : 0;
   });
   return { centre, radius, extremities, between };
 }
@@ -232,12 +233,13 @@ export function matchExtremities(referenceSet, sourceSet, { maxDistortion = 0.2,
   const ri = [];
   const sj = [];
   const usedS = new Uint8Array(source.length);
-  let best = { cost: unpaired * Math.min(reference.length, source.length), ri: [], sj: [] };
+  const most = Math.min(reference.length, source.length);
+  let best = { cost: unpaired * most, ri: [], sj: [] };
   const search = (i, unarySum, pairSum) => {
     const m = ri.length;
-    const cost = unarySum + (m > 1 ? (2 * pairSum) / (m - 1) : 0) + unpaired * (Math.min(reference.length, source.length) - m);
+    const cost = unarySum + (m > 1 ? (2 * pairSum) / (m - 1) : 0) + unpaired * (most - m);
     if (cost < best.cost - 1e-12) best = { cost, ri: ri.slice(), sj: sj.slice() };
-    if (i >= reference.length || m >= Math.min(reference.length, source.length)) return;
+    if (i >= reference.length || m >= most) return;
     search(i + 1, unarySum, pairSum); // reference extremity i unpaired
     for (let j = 0; j < source.length; ++j) {
       if (usedS[j]) continue;
