@@ -62,6 +62,10 @@ const OptionSchema<PartTransferOptions>& transfer_part_options() {
              "--parts auto: isoline perimeter growth that marks where a limb meets the body");
     s.number("max_part_area", [](O& o) -> double& { return o.max_part_area; }, 0, 1,
              "--parts auto: largest part, as a fraction of the surface area");
+    s.integer("proposal_sets", [](O& o) -> int& { return o.proposal_sets; }, 1, 5,
+              "--parts auto: part sets tried, cut at more distances from the tips each; the one whose landmarks land closest is kept");
+    s.number("max_seam_dihedral_mean", [](O& o) -> double& { return o.max_seam_dihedral_mean; }, 0, 180,
+             "a glued part is rejected when the mean dihedral-angle change across its cut exceeds this (degrees)");
     return s;
   }();
   return schema;
@@ -166,6 +170,12 @@ std::string transfer_summary(const TransferJobResult& r, const PoseTransferOptio
     std::snprintf(buf, sizeof buf, "  parts: %zu part pairs, %zu kept, in %.0f ms (level 1 %.0f ms, total %.0f ms)\n",
                   r.parts.reports.size(), kept, r.parts.ms_parts, r.parts.ms_level1, r.parts.ms_total);
     s += buf;
+    if (r.parts.proposals_tried > 1) {
+      std::snprintf(buf, sizeof buf,
+                    "  automatic parts: %d proposal sets tried (neck windows), set %d kept: level landmark error %.4f -> %.4f\n",
+                    r.parts.proposals_tried, r.parts.proposal_kept + 1, r.parts.landmark_error_level1, r.parts.landmark_error);
+      s += buf;
+    }
     for (const PartReport& p : r.parts.reports) {
       std::snprintf(buf, sizeof buf,
                     "    level %d %s: %d / %d vertices, %d subdivisions, %d landmarks, rotation %.1f°, seam dihedral change mean %.1f° max %.1f°, %.0f ms%s%s\n",

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <string>
 
 #include "app/transfer_job.h"
@@ -199,15 +200,15 @@ TEST(PartRegions, DiskPlaneAndErrors) {
 // ---------------------------------------------------------------------------------------------
 // Two-level transfer, same connectivity with ground truth.
 
-// Measured (native Release, shared 2-core machine; docs/transfer.md has the table): the gate
-// (PartTransferOptions::reject_worse_parts) keeps a part only if it adds no flipped face, keeps
-// the self-intersections within the reference + source bound and does not move the generated
-// landmark pairs away from the reference. Issue 16 asks for a lower aligned error than one level
-// on every pair and ≥ 35% lower where limbs move: the 35% is reached on none (best: cat-01,
-// 15%). On lion-01 and lion-05 the accepted parts lower the landmark error but not the vertex
-// error (lion-01 0.056 → 0.060, lion-05 0.0376 → 0.0378; without the gate lion-05 reached
-// 0.029 at the price of 3 flipped faces), so `improves` is false there and the test bounds the
-// measured error instead.
+// Measured (docs/transfer.md has the table): the gate (PartTransferOptions::reject_worse_parts)
+// keeps a part only if it adds no flipped face, keeps the self-intersections within the
+// reference + source bound, leaves no seam and does not move the generated landmark pairs away
+// from the reference; automatic parts try up to five proposal sets (neck windows) and keep the
+// one whose landmarks land closest. Issue 16 asks for a lower aligned error than one level on
+// every pair and ≥ 35% lower where limbs move: natively cat-05 −52 %, lion-05 −28 %, cat-01 −16 %,
+// cat-07 −10 %, horse15 −8 %, lion-07 −6.5 %; lion-01 is 10.7 % worse (its parts lower the 30
+// landmarks' error, 0.072 → 0.065, but not the vertex error). The builds pick different sets
+// where two come close (lion-05 in wasm: −1.0 %), so the bounds below hold both.
 struct PartPairCase {
   const char* pose;
   const char* rest;
@@ -219,6 +220,8 @@ class PartTransferSame : public testing::TestWithParam<PartPairCase> {};
 
 TEST_P(PartTransferSame, TwoLevelsAgainstOneLevel) {
   const PartPairCase& c = GetParam();
+  if (!std::filesystem::exists(test::data_path(c.pose)) || !std::filesystem::exists(test::data_path(c.rest)))
+    GTEST_SKIP() << "not in this checkout: " << c.pose << " (held-out pairs come from ../shared/data)";
   const Mesh P = test::load_mesh(c.pose), S = test::load_mesh(c.rest);
   const PartTransferResult r = part_transfer(P, S, {}, nullptr);
   ASSERT_TRUE(r.status.ok()) << r.status.message;
@@ -252,24 +255,26 @@ TEST_P(PartTransferSame, TwoLevelsAgainstOneLevel) {
   }
 }
 
-// improves: two levels asserted lower than one. cat-07 (−0.3 % natively) and lion-07 (−2.8 %)
-// are not: in wasm the quality gate rejects their parts (one flip differs), so both levels are
-// equal there; lion-01 and lion-05 do not improve (docs/transfer.md).
+// Test name: the pose file's stem without dashes ("cat01").
+std::string pair_case_name(const testing::TestParamInfo<PartPairCase>& info) {
+  std::string n = info.param.pose;
+  n = n.substr(n.rfind('/') + 1);
+  n = n.substr(0, n.find('.'));
+  n.erase(std::remove(n.begin(), n.end(), '-'), n.end());
+  return n;
+}
+
+// improves: two levels asserted lower than one (native and wasm); max_error: measured in both
+// builds + margin.
 INSTANTIATE_TEST_SUITE_P(Pairs, PartTransferSame,
                          testing::Values(PartPairCase{"pose/cat-01.ply", "pose/cat-reference.ply", true, 0.056},
-                                         PartPairCase{"pose/cat-05.ply", "pose/cat-reference.ply", true, 0.054},
-                                         PartPairCase{"pose/cat-07.ply", "pose/cat-reference.ply", false, 0.086},
+                                         PartPairCase{"pose/cat-05.ply", "pose/cat-reference.ply", true, 0.030},
+                                         PartPairCase{"pose/cat-07.ply", "pose/cat-reference.ply", true, 0.080},
                                          PartPairCase{"pose/lion-01.ply", "pose/lion-reference.ply", false, 0.063},
-                                         PartPairCase{"pose/lion-05.ply", "pose/lion-reference.ply", false, 0.040},
-                                         PartPairCase{"pose/lion-07.ply", "pose/lion-reference.ply", false, 0.099},
+                                         PartPairCase{"pose/lion-05.ply", "pose/lion-reference.ply", true, 0.040},
+                                         PartPairCase{"pose/lion-07.ply", "pose/lion-reference.ply", true, 0.097},
                                          PartPairCase{"pose/horse15.ply", "pose/horse0.ply", true, 0.044}),
-                         [](const testing::TestParamInfo<PartPairCase>& info) {
-                           std::string n = info.param.pose;
-                           n = n.substr(n.find('/') + 1);
-                           n = n.substr(0, n.find('.'));
-                           n.erase(std::remove(n.begin(), n.end(), '-'), n.end());
-                           return n;
-                         });
+                         pair_case_name);
 
 // ---------------------------------------------------------------------------------------------
 // Different connectivity.
@@ -382,3 +387,15 @@ TEST(PartTransferJob, NestedPartsFromAFile) {
   EXPECT_EQ(e.status.code, StatusCode::InvalidArgument);
   EXPECT_NE(e.status.message.find("part \"tail\""), std::string::npos) << e.status.message;
 }
+
+
+// Held out: the same-connectivity pairs of ../shared/data that the repository does not carry
+// (Sumner's horse, TOSCA's michael at 52k vertices). The proposal windows were chosen on the
+// pairs above; these check them on others (horse-03 −11 %, horse-07 −3 %; michael9: a set 0.7 %
+// closer by its landmarks, 17 % lower error, is within proposal_tie of the first set, which
+// keeps no part there). Skipped in a fresh clone without ../shared.
+INSTANTIATE_TEST_SUITE_P(HeldOut, PartTransferSame,
+                         testing::Values(PartPairCase{"../../shared/data/pose/sumner/horse-03.obj", "../../shared/data/pose/sumner/horse_ref.obj", true, 0.052},
+                                         PartPairCase{"../../shared/data/pose/sumner/horse-07.obj", "../../shared/data/pose/sumner/horse_ref.obj", true, 0.046},
+                                         PartPairCase{"../../shared/data/pose/tosca/michael9.off", "../../shared/data/pose/tosca/michael3.off", false, 0.058}),
+                         pair_case_name);

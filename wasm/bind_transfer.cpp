@@ -125,6 +125,10 @@ val part_transfer_js(val ref_positions, val ref_indices, val src_positions, val 
   out.set("positions", to_float64_array(r.V));
   out.set("positionsLevel1", to_float64_array(r.V_level1));
   out.set("partsJson", io::parts_json(r.parts));
+  out.set("proposalsTried", r.proposals_tried);
+  out.set("proposalKept", r.proposal_kept);
+  out.set("landmarkErrorLevel1", r.landmark_error_level1);
+  out.set("landmarkError", r.landmark_error);
   val list = val::array();
   // Each part's source vertices (its region on the source input mesh, whose vertex ids the
   // result shares), for the page's part colours.

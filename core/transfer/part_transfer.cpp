@@ -251,6 +251,18 @@ std::vector<LandmarkPair> part_landmarks(const PartMesh& R, const PartMesh& S, c
   return out;
 }
 
+// Same regions, names aside (proposals of two neck windows often coincide).
+bool part_lists_equal(const std::vector<PartPair>& a, const std::vector<PartPair>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (!part_regions_equal(a[i].source, b[i].source) || !part_regions_equal(a[i].reference, b[i].reference) ||
+        !part_lists_equal(a[i].children, b[i].children))
+      return false;
+  return true;
+}
+
+bool part_specs_equal(const PartsSpec& a, const PartsSpec& b) { return part_lists_equal(a.parts, b.parts); }
+
 }  // namespace part_detail
 
 using namespace part_detail;
@@ -459,8 +471,22 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     out.status = cancelled_status("part proposals");
     return out;
   }
-  if (spec) out.parts = *spec;
-  else out.parts = propose_parts(reference, source, Vcur, out.level1.landmarks, opt, &out.disagreement);
+  // The part sets to try: the given one, or the proposals of each neck window that gives a set
+  // not seen before (PartTransferOptions::more_proposal_windows).
+  std::vector<PartsSpec> candidates;
+  if (spec) {
+    candidates.push_back(*spec);
+  } else {
+    candidates.push_back(propose_parts(reference, source, Vcur, out.level1.landmarks, opt, &out.disagreement));
+    for (size_t k = 0; k < opt.more_proposal_windows.size() && static_cast<int>(k) + 1 < opt.proposal_sets; ++k) {
+      const PartTransferOptions::ProposalWindow& w = opt.more_proposal_windows[k];
+      PartTransferOptions o = opt;
+      o.neck_window_begin = w.neck_window_begin, o.neck_window_end = w.neck_window_end, o.max_part_area = w.max_part_area;
+      PartsSpec c = propose_parts(reference, source, Vcur, out.level1.landmarks, o);
+      if (std::none_of(candidates.begin(), candidates.end(), [&](const PartsSpec& x) { return part_specs_equal(x, c); }))
+        candidates.push_back(std::move(c));
+    }
+  }
 
   const int nS = source.num_vertices(), nR = reference.num_vertices();
   const bool same_conn = nS == nR && reference.F == source.F;
@@ -470,8 +496,10 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     for (const PartPair& p : l) c += 1 + count_parts(p.children);
     return c;
   };
-  const int total_parts = count_parts(out.parts.parts);
+  int total_parts = 0;
+  for (const PartsSpec& c : candidates) total_parts += count_parts(c.parts);
   int done = 0;
+  std::vector<PartReport>* reports = &out.reports;  // of the candidate being run
   // Running fold counts of Vcur and the level's landmark error (quality gate, see transfer_part).
   int si_current = out.folds_level1.self_intersections_result;
   int flips_current = out.folds_level1.flipped_faces;
@@ -509,7 +537,7 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     auto skip = [&](Status s) {
       rep.status = s;
       rep.ms = part_ms_since(t0);
-      out.reports.push_back(rep);
+      reports->push_back(rep);
       return Status::success();
     };
     if (S.boundary.empty() || R.boundary.empty() || S.tip < 0 || R.tip < 0)
@@ -622,6 +650,9 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     rep.landmark_error_after = lm_error(fin.V);
     rep.self_intersections_added = si_after - si_current;
     rep.flips_added = flips_after - flips_current;
+    part_seam_dihedral(fin.V, source.V, source.F, in_part, &rep.seam_dihedral_mean, &rep.seam_dihedral_max);
+    rep.seam_dihedral_mean_before = l1_mean;
+    rep.seam_dihedral_max_before = l1_max;
     if (opt.reject_worse_parts) {
       std::string why;
       // Issue 16's bound: no more self-intersecting pairs than the reference and the source
@@ -633,6 +664,9 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
                std::to_string(si_bound) + ")";
       if (flips_after > flips_current) why += ", adds " + std::to_string(flips_after - flips_current) + " flipped faces";
       if (rep.landmark_error_after > rep.landmark_error_before) why += ", moves the landmarks away from the reference";
+      if (rep.seam_dihedral_mean > opt.max_seam_dihedral_mean)
+        why += ", leaves a seam (mean dihedral change " + std::to_string(static_cast<int>(std::lround(rep.seam_dihedral_mean))) +
+               "° across the cut)";
       if (!why.empty()) {
         rep.rejected = true;
         return skip(Status::error(StatusCode::NotConverged, "rejected: the glued part" + why.substr(1)));
@@ -640,13 +674,10 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     }
     si_current = si_after;
     flips_current = flips_after;
-    part_seam_dihedral(fin.V, source.V, source.F, in_part, &rep.seam_dihedral_mean, &rep.seam_dihedral_max);
-    rep.seam_dihedral_mean_before = l1_mean;
-    rep.seam_dihedral_max_before = l1_max;
     Vcur = fin.V;
     rep.glue_ms = part_ms_since(t_glue);
     rep.ms = part_ms_since(t0);
-    out.reports.push_back(rep);
+    reports->push_back(rep);
     return Status::success();
   };
   std::function<Status(const std::vector<PartPair>&, int)> run_level = [&](const std::vector<PartPair>& list,
@@ -658,11 +689,33 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     }
     return Status::success();
   };
-  if (Status s = run_level(out.parts.parts, 2); !s.ok()) {
-    out.status = s;
-    return out;
+  // Each candidate from the level-1 result; the one whose level landmark pairs end closest to the
+  // reference is kept. Within `proposal_tie` (relative) of the best so far counts as a tie, which
+  // the earlier candidate wins: near-equal sets are told apart by the last bits of the part
+  // transfers, which differ between builds (docs/transfer.md).
+  out.landmark_error_level1 = lm_error(out.V_level1);
+  const int si_level1 = si_current, flips_level1 = flips_current;
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t c = 0; c < candidates.size(); ++c) {
+    Vcur = out.V_level1;
+    si_current = si_level1, flips_current = flips_level1;
+    std::vector<PartReport> tried;
+    reports = &tried;
+    if (Status s = run_level(candidates[c].parts, 2); !s.ok()) {
+      out.status = s;
+      return out;
+    }
+    const double e = lm_error(Vcur);
+    if (e < best * (1 - opt.proposal_tie)) {
+      best = e;
+      out.V = Vcur;
+      out.reports = std::move(tried);
+      out.parts = candidates[c];
+      out.proposal_kept = static_cast<int>(c);
+      out.landmark_error = e;
+    }
   }
-  out.V = Vcur;
+  out.proposals_tried = spec ? 0 : static_cast<int>(candidates.size());
   out.ms_parts = part_ms_since(t_parts);
   out.folds = fold_report(reference, source, out.V);
   out.ms_total = part_ms_since(t_start);

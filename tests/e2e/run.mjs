@@ -1255,18 +1255,26 @@ it('transfer parts: automatic parts on the crouching cat — proposed, transferr
   meshOps.load(ctx, { name: 'cat-reference.ply', slot: 'source' }, { 'cat-reference.ply': new Uint8Array(fs.readFileSync(sourceFile)) });
   const inNode = transferOps.partTransfer(ctx, { referenceSlot: 'reference', sourceSlot: 'source', method: 'yin', parts: 'auto' }).buffers.positions;
   check(inNode.length === result.length && inNode.every((v, i) => v === result[i]), `the page and the node wasm module differ (max ${maxDistance(inNode, result) / diagonal}·diag)`);
-  // The CLI on the same files (native build): the same parts kept; the mesh within the
-  // native/wasm difference of the parts' own transfers (docs/transfer.md: the eigensolver's last
-  // bits, amplified on near-cylindrical limbs; measured up to 4.7e-3 of the diagonal on the
-  // lion's leg and paw).
+  // The CLI on the same files (native build) with the parts the page kept (its proposal set:
+  // automatic parts try several sets and keep the one whose landmarks land closest, and where two
+  // sets come close the builds' last bits can pick differently — docs/transfer.md): the same
+  // parts kept; the mesh within the native/wasm difference of the parts' own transfers (the
+  // eigensolver's last bits, amplified on near-cylindrical limbs; measured up to 4.7e-3 of the
+  // diagonal on the lion's leg and paw).
   const cliOut = path.join(shotDir, 'cat01-parts-cli.ply');
   const cliParts = path.join(shotDir, 'cat01-parts-cli.json');
-  const run = spawnSync(cliPath, ['transfer', '--reference', referenceFile, '--source', sourceFile, '--parts', 'auto', '--out', cliOut, '--parts-out', cliParts], { encoding: 'utf8', timeout: 120000 });
-  check(run.status === 0, `meshmorph transfer --parts auto failed (${run.status}): ${run.stderr}`);
+  const pageParts = path.join(shotDir, 'cat01-parts-page.json');
+  fs.writeFileSync(pageParts, t.result.parts.info.partsJson);
+  const proposals = t.result.parts.info.proposals;
+  check(proposals && proposals.tried >= 1 && proposals.kept < proposals.tried && proposals.landmarkError <= proposals.landmarkErrorLevel1,
+    `proposal sets: ${JSON.stringify(proposals)}`);
+  check(proposals.tried < 2 || await page.isVisible('#tr-parts-proposals'), 'the proposal sets tried are not shown');
+  const run = spawnSync(cliPath, ['transfer', '--reference', referenceFile, '--source', sourceFile, '--parts', pageParts, '--out', cliOut, '--parts-out', cliParts], { encoding: 'utf8', timeout: 120000 });
+  check(run.status === 0, `meshmorph transfer --parts (the page's) failed (${run.status}): ${run.stderr}`);
   const cli = readPlyVertices(fs.readFileSync(cliOut));
   const cliDifference = maxDistance(cli, result) / diagonal;
   const cliKept = (run.stdout.match(/(\d+) kept/) || [])[1];
-  console.log(`     page vs CLI (--parts auto): max vertex difference ${cliDifference.toExponential(2)}·diag; CLI kept ${cliKept} of ${JSON.parse(fs.readFileSync(cliParts, 'utf8')).parts.length}`);
+  console.log(`     proposal sets: ${proposals.tried} tried, set ${proposals.kept + 1} kept; page vs CLI (the page's parts): max vertex difference ${cliDifference.toExponential(2)}·diag; CLI kept ${cliKept} of ${JSON.parse(fs.readFileSync(cliParts, 'utf8')).parts.length}`);
   check(Number(cliKept) === kept.length, `the CLI kept ${cliKept} parts, the page ${kept.length}`);
   check(cliDifference < 2e-2, `page and CLI differ by ${cliDifference}·diag`);
 

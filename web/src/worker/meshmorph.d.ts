@@ -171,8 +171,10 @@ export type Op = (ctx: OpContext, options: object, buffers: Buffers) => { buffer
 // partTransfer {referenceSlot?, sourceSlot?, landmarks?, parts: 'auto' | part-file text,
 //          partOptions?: optionSchema {job: 'transfer-parts'}, ...transfer options}
 //          → {positions, positionsLevel1, partLabels: Int32Array (deepest part per welded source
-//            vertex, -1 outside)} / {level1 (as transfer's info), partsJson, parts: [{name, level,
-//            ok, message, rejected, ...}], folds, ms} (hierarchical part transfer, paper 000 Sec. 4.3)
+//            vertex, -1 outside)} / {level1 (as transfer's info), partsJson, proposals: {tried,
+//            kept, landmarkErrorLevel1, landmarkError} (automatic parts: proposal sets tried and
+//            the one kept), parts: [{name, level, ok, message, rejected, ...}], folds, ms}
+//            (hierarchical part transfer, paper 000 Sec. 4.3)
 // ---- edit ops (ops/edit.js): positions results carry {positions, rawPositions, rawNormals}
 // ---- debug ops (ops/debug.js; the e2e recovery checks only)
 // debugExhaustMemory {} → {} / {allocatedMB};  debugCrash {} → the worker dies after answering

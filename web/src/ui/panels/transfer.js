@@ -134,6 +134,7 @@ const markup = `
     </div>
     <div id="tr-parts-result" hidden>
       <div class="row"><label title="Each part's region in its own colour on the source side"><input type="checkbox" id="tr-part-colours" checked /> Colour the parts</label></div>
+      <p id="tr-parts-proposals" class="hint" hidden></p>
       <table class="landmarks parts"><thead><tr><th>#</th><th>part</th><th>level</th><th>result</th><th>vertices</th><th title="registration by the local frames (Sec. 4.3)">rotation</th></tr></thead><tbody></tbody></table>
     </div>
   </div>
@@ -622,6 +623,10 @@ export const panel = {
       $('tr-parts-save').disabled = !parts;
       const body = root.querySelector('#tr-parts-result tbody');
       body.replaceChildren();
+      const proposals = parts?.proposals;
+      $('tr-parts-proposals').hidden = !(proposals?.tried > 1);
+      if (proposals?.tried > 1)
+        $('tr-parts-proposals').textContent = `${proposals.tried} proposal sets tried (cuts nearer and farther from the tips); set ${proposals.kept + 1} kept: landmark error ${fixed(proposals.landmarkErrorLevel1, 4)} → ${fixed(proposals.landmarkError, 4)}`;
       if (!parts) return;
       parts.parts.forEach((p, i) => {
         let outcome = 'kept';
@@ -648,7 +653,7 @@ export const panel = {
       const mode = $('tr-parts').value;
       transfer.parts = mode;
       let hint = '';
-      if (mode === 'auto') hint = 'After the whole-body transfer, parts where the pose still disagrees most (limbs, head, tail) are proposed, transferred again and glued back; a part that would add folds or flips is rejected. Save parts gives the proposals to edit.';
+      if (mode === 'auto') hint = 'After the whole-body transfer, parts where the pose still disagrees most (limbs, head, tail) are proposed with cuts at several distances from their tips, transferred again and glued back, and the set whose landmarks land closest to the reference is kept; a part that would add folds, flips or a seam is rejected. Save parts gives the parts used, to edit.';
       else if (mode === 'file') hint = `${transfer.partsFile.count} part pair${transfer.partsFile.count === 1 ? '' : 's'} from ${transfer.partsFile.name}.`;
       $('tr-parts-hint').textContent = hint;
       if (partForm) partForm.element.hidden = mode === 'none';
