@@ -706,7 +706,7 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
       return out;
     }
     const double e = lm_error(Vcur);
-    if (e < best * (1 - opt.proposal_tie)) {
+    if (c == 0 || e < best * (1 - opt.proposal_tie)) {  // the first set always stands (a NaN error included)
       best = e;
       out.V = Vcur;
       out.reports = std::move(tried);
