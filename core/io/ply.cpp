@@ -418,6 +418,8 @@ Status save_ply_document(const PlyDocument& doc, const Eigen::MatrixXi& F_raw,
   for (size_t ei = 0; ei < doc.elements.size(); ++ei) {
     const PlyElement& e = doc.elements[ei];
     const bool is_vertex = static_cast<int>(ei) == doc.vertex_element;
+    // Rows without properties hold no bytes (the reader skips them too); a huge count must not loop.
+    if (e.properties.empty()) continue;
     for (size_t r = 0; r < e.count; ++r) {
       std::string line;
       for (size_t pi = 0; pi < e.properties.size(); ++pi) {
