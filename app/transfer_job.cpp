@@ -66,12 +66,20 @@ const OptionSchema<PartTransferOptions>& transfer_part_options() {
               "--parts auto: part sets tried, cut at more distances from the tips each; the one whose landmarks land closest is kept");
     s.number("max_seam_dihedral_mean", [](O& o) -> double& { return o.max_seam_dihedral_mean; }, 0, 180,
              "a glued part is rejected when the mean dihedral-angle change across its cut exceeds this (degrees)");
+    s.boolean("rigid_when_folded", [](O& o) -> bool& { return o.rigid_when_folded; },
+              "a part whose own transfer folds faces is turned rigidly onto its landmarks instead");
     return s;
   }();
   return schema;
 }
 
 namespace {
+// "rotation", or how a part that was registered rigidly came to be (its transfer folded faces).
+std::string rigid_note(const PartReport& p) {
+  if (!p.rigid) return "rotation";
+  return "rigid (its transfer folded " + std::to_string(p.transfer_flips) + " faces), rotation";
+}
+
 TransferJobResult transfer_job_failure(Status s) {
   TransferJobResult r;
   r.status = std::move(s);
@@ -178,9 +186,9 @@ std::string transfer_summary(const TransferJobResult& r, const PoseTransferOptio
     }
     for (const PartReport& p : r.parts.reports) {
       std::snprintf(buf, sizeof buf,
-                    "    level %d %s: %d / %d vertices, %d subdivisions, %d landmarks, rotation %.1f°, seam dihedral change mean %.1f° max %.1f°, %.0f ms%s%s\n",
+                    "    level %d %s: %d / %d vertices, %d subdivisions, %d landmarks, %s %.1f°, seam dihedral change mean %.1f° max %.1f°, %.0f ms%s%s\n",
                     p.level, p.name.empty() ? "(unnamed)" : p.name.c_str(), p.source_vertices, p.reference_vertices,
-                    p.subdivisions, p.landmarks, p.rotation_degrees, p.seam_dihedral_mean, p.seam_dihedral_max, p.ms,
+                    p.subdivisions, p.landmarks, rigid_note(p).c_str(), p.rotation_degrees, p.seam_dihedral_mean, p.seam_dihedral_max, p.ms,
                     p.status.ok() ? "" : ", skipped: ", p.status.ok() ? "" : p.status.message.c_str());
       s += buf;
     }

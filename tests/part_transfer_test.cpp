@@ -32,9 +32,9 @@ std::vector<LandmarkPair> load_pairs(const std::string& rel) {
 
 void print_reports(const char* what, const PartTransferResult& r) {
   for (const PartReport& p : r.reports)
-    std::printf("[ parts ] %s: level %d %-48s %s | %d/%d v, sub %d, lm %d, seam %d v, rot %.1f°, seam Δdihedral mean %.2f° max %.1f° (before %.2f° / %.1f°), %.0f ms\n",
+    std::printf("[ parts ] %s: level %d %-48s %s | %d/%d v, sub %d, lm %d, seam %d v, %srot %.1f°, seam Δdihedral mean %.2f° max %.1f° (before %.2f° / %.1f°), %.0f ms\n",
                 what, p.level, p.name.c_str(), p.status.ok() ? "ok" : p.status.message.c_str(), p.source_vertices,
-                p.reference_vertices, p.subdivisions, p.landmarks, p.seam_vertices, p.rotation_degrees,
+                p.reference_vertices, p.subdivisions, p.landmarks, p.seam_vertices, p.rigid ? "rigid, " : "", p.rotation_degrees,
                 p.seam_dihedral_mean, p.seam_dihedral_max, p.seam_dihedral_mean_before, p.seam_dihedral_max_before, p.ms);
 }
 
@@ -279,12 +279,20 @@ INSTANTIATE_TEST_SUITE_P(Pairs, PartTransferSame,
 // ---------------------------------------------------------------------------------------------
 // Different connectivity.
 
-TEST(PartTransferDifferent, CatToLionAndHorseToCamel) {
+TEST(PartTransferDifferent, CatToLionHorseToCamelMichaelToArmadillo) {
   struct Case {
     const char *ref, *src, *lm, *gt;
+    double max_landmark_ratio;  // two levels / one level, measured + margin
   };
-  for (const Case& c : {Case{"pose/cat-01.ply", "pose/lion-reference.ply", "landmarks/cat-lion.json", "pose/lion-01.ply"},
-                        Case{"pose/horse0.ply", "pose/camel_ref.ply", "landmarks/horse0-camel_ref.json", nullptr}}) {
+  // michael9 (52,565 vertices) comes from ../shared/data: skipped without it.
+  for (const Case& c : {Case{"pose/cat-01.ply", "pose/lion-reference.ply", "landmarks/cat-lion.json", "pose/lion-01.ply", 0.85},
+                        Case{"pose/horse0.ply", "pose/camel_ref.ply", "landmarks/horse0-camel_ref.json", nullptr, 0.97},
+                        Case{"../../shared/data/pose/tosca/michael9.off", "edit/armadillo.ply", "landmarks/michael3-armadillo.json",
+                             nullptr, 0.98}}) {
+    if (!std::filesystem::exists(test::data_path(c.ref))) {
+      std::printf("[ parts ] %s not in this checkout (../shared/data): skipped\n", c.ref);
+      continue;
+    }
     const Mesh R = test::load_mesh(c.ref), S = test::load_mesh(c.src);
     const auto pairs = part_transfer_test::load_pairs(c.lm);
     const PartTransferResult r = part_transfer(R, S, pairs, nullptr);
@@ -303,23 +311,24 @@ TEST(PartTransferDifferent, CatToLionAndHorseToCamel) {
       g1 = aligned_vertex_error(r.V_level1, G.V);
       g2 = aligned_vertex_error(r.V, G.V);
     }
-    std::printf("[ parts ] %s -> %s: landmark error level 1 %.4f, two levels %.4f | gt %.4f -> %.4f | flips %d -> %d | self-intersections ref %d src %d level1 %d result %d | %.0f + %.0f ms\n",
-                c.ref, c.src, l1, l2, g1, g2, m1.flipped_faces, m2.flipped_faces,
+    int rigid = 0;
+    for (const PartReport& p : r.reports) rigid += p.status.ok() && p.rigid;
+    std::printf("[ parts ] %s -> %s: landmark error level 1 %.4f, two levels %.4f (%.1f%% lower) | gt %.4f -> %.4f | flips %d -> %d | self-intersections ref %d src %d level1 %d result %d | %d sets, %d rigid parts kept | %.0f + %.0f ms\n",
+                c.ref, c.src, l1, l2, 100 * (1 - l2 / l1), g1, g2, m1.flipped_faces, m2.flipped_faces,
                 r.folds.self_intersections_reference, r.folds.self_intersections_source,
-                r.folds_level1.self_intersections_result, r.folds.self_intersections_result, r.ms_level1, r.ms_parts);
+                r.folds_level1.self_intersections_result, r.folds.self_intersections_result, r.proposals_tried, rigid,
+                r.ms_level1, r.ms_parts);
     part_transfer_test::print_reports(c.ref, r);
     EXPECT_LE(m2.flipped_faces, m1.flipped_faces);
     EXPECT_LE(r.folds.self_intersections_result,
               std::max(r.folds.self_intersections_reference + r.folds.self_intersections_source,
                        r.folds_level1.self_intersections_result));
-    EXPECT_LE(l2, l1);  // the gate's invariant, on the job's own landmark pairs
-    // cat-01 → lion: lion-01 (Sumner's transfer of cat-01) is a rough ground truth the
-    // algorithm never sees. Issue 16 asks for a lower error than one level here; measured: every
-    // proposed part is rejected by the gate (cat → lion: the 7–8-landmark part transfers add
-    // 4–328 self-intersecting pairs and 4–65 flipped faces) or cannot be glued (horse → camel:
-    // camel_ref's non-manifold vertices in the seam band), so two levels equal one level. The
-    // test keeps the part that can fail: not worse than one level.
-    if (c.gt) EXPECT_LE(g2, g1);
+    // Issue 16: a lower landmark error than one level. The parts' own transfers fold here (7–9
+    // landmarks per part), so the parts that are kept are the rigidly turned ones
+    // (rigid_when_folded). Measured natively: cat → lion −19 % (ground truth −23 %), horse →
+    // camel −5.0 %, michael → armadillo −3.7 %.
+    EXPECT_LE(l2, c.max_landmark_ratio * l1);
+    if (c.gt) EXPECT_LE(g2, 0.85 * g1);  // lion-01: Sumner's own transfer of cat-01, never seen by the method
   }
 }
 

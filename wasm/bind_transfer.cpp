@@ -151,6 +151,8 @@ val part_transfer_js(val ref_positions, val ref_indices, val src_positions, val 
     o.set("subdivisions", p.subdivisions);
     o.set("landmarks", p.landmarks);
     o.set("rotationDegrees", p.rotation_degrees);
+    o.set("rigid", p.rigid);
+    o.set("transferFlips", p.transfer_flips);
     o.set("seamDihedralMean", p.seam_dihedral_mean);
     o.set("seamDihedralMax", p.seam_dihedral_max);
     o.set("rejected", p.rejected);

@@ -417,6 +417,15 @@ PartsSpec propose_parts(const Mesh& reference, const Mesh& source, const Eigen::
     std::vector<double> dt(n, std::numeric_limits<double>::infinity());
     relax_edge_distances(source.V, adj_s, tip, &dt);
     for (int v : blob) r_blob = std::max(r_blob, dt[v]);
+    if (!same) {
+      // Different connectivity: only landmarks tell where the pose agrees again. The high-
+      // disagreement region is taken to reach halfway to the nearest landmark that agrees
+      // (below blob_fraction × the worst); without one, the neck window is open.
+      double agree = std::numeric_limits<double>::infinity();
+      for (const LandmarkPair& l : landmarks)
+        if (d[l.source] < opt.blob_fraction * d[worst]) agree = std::min(agree, dt[l.source]);
+      if (std::isfinite(agree)) r_blob = 0.5 * agree;
+    }
     const double radius = part_neck_radius(source.V, source.F, adj_s, tip, opt.neck_window_begin * r_blob,
                                            opt.neck_window_end * r_blob, opt);
     // Mark the region (and what the disk would cover) taken either way, so the next proposal
@@ -424,9 +433,9 @@ PartsSpec propose_parts(const Mesh& reference, const Mesh& source, const Eigen::
     for (int v : blob) taken[v] = 1;
     for (int v = 0; v < n; ++v)
       if (dt[v] < std::max(radius, r_blob) * 1.15) taken[v] = 1;
-    if (!(radius > 0) || tip_ref < 0) continue;
     int inside = 0;
     for (int v = 0; v < n; ++v) inside += dt[v] < radius;
+    if (!(radius > 0) || tip_ref < 0) continue;
     if (inside < opt.min_part_fraction * n) continue;  // too small to carry a pose of its own
     PartPair pp;
     char name[96];
@@ -491,6 +500,10 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
   const int nS = source.num_vertices(), nR = reference.num_vertices();
   const bool same_conn = nS == nR && reference.F == source.F;
   const auto adj_full = vertex_adjacency(source.F, nS);
+  // The editor solves only over manifold vertices; a non-manifold one in a seam band is glued
+  // as a known vertex instead (TOSCA camel_ref has 3 where its horse part is cut).
+  std::vector<char> non_manifold(nS, 0);
+  for (const VertexFans& v : non_manifold_vertices(source.F, nS)) non_manifold[v.vertex] = 1;
   std::function<int(const std::vector<PartPair>&)> count_parts = [&](const std::vector<PartPair>& l) {
     int c = 0;
     for (const PartPair& p : l) c += 1 + count_parts(p.children);
@@ -568,6 +581,9 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     Eigen::MatrixXd T;
     Eigen::MatrixXi Fc;
     butterfly_coarsen(t.V, Ssub.F, levels, static_cast<int>(S.V.rows()), &T, &Fc);
+    rep.transfer_flips = transfer_metrics(T, S.V, S.F).flipped_faces;
+    rep.rigid = opt.rigid_when_folded && rep.transfer_flips > 0;
+    if (rep.rigid) T = S.V;  // the level-1 shape, turned below
     // Step 4: registration by local frames, rotation about the boundary centroid, then the
     // boundary centroid onto the level-1 one.
     bool axis_t = false, axis_r = false;
@@ -576,6 +592,32 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     Eigen::Matrix3d Rot;
     if (axis_t || axis_r) Rot = Eigen::Quaterniond::FromTwoVectors(Et.col(0), Er.col(0)).toRotationMatrix();
     else Rot = Er * Et.transpose();
+    if (rep.rigid) {
+      // The rotation that best maps the part's landmark pairs (every vertex when the part pair
+      // has one connectivity), each taken from its part's cut centre (Umeyama, with scale: the
+      // meshes differ in size).
+      Eigen::MatrixXd P, Q;
+      if (same_pair) {
+        P = S.V, Q = R.V;
+      } else {
+        P.resize(static_cast<Eigen::Index>(lm.size()), 3), Q.resize(static_cast<Eigen::Index>(lm.size()), 3);
+        for (size_t k = 0; k < lm.size(); ++k) {
+          P.row(static_cast<Eigen::Index>(k)) = S.V.row(lm[k].source);
+          Q.row(static_cast<Eigen::Index>(k)) = R.V.row(lm[k].reference);
+        }
+      }
+      P.rowwise() -= part_boundary_centroid(S.V, S.boundary).transpose();
+      Q.rowwise() -= part_boundary_centroid(R.V, R.boundary).transpose();
+      RigidFitOptions ro;
+      ro.scale = true;
+      ro.rotation_prior = 0.01;  // landmarks along a limb say little about the turn about it: none then
+      const RigidFit fit = fit_rigid(P, Q, ro);
+      if (fit.degenerate)
+        return skip(Status::error(StatusCode::InvalidArgument, "its transfer folded " + std::to_string(rep.transfer_flips) +
+                                                                  " faces, and its " + std::to_string(P.rows()) +
+                                                                  " landmarks are too few to turn it rigidly"));
+      Rot = fit.R;
+    }
     rep.rotation_degrees = Eigen::AngleAxisd(Rot).angle() * 180.0 / M_PI;
     // Transfer I already gives the part the reference part's orientation (the low frequencies
     // carry it), so a large frame rotation means an ill-conditioned frame (a short or straight
@@ -586,7 +628,7 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     // 43.0° in wasm, one side of the cut each).
     const double taper_lo = opt.max_registration_degrees - 15, taper_hi = opt.max_registration_degrees + 15;
     const double keep = std::clamp((taper_hi - rep.rotation_degrees) / (taper_hi - taper_lo), 0.0, 1.0);
-    if (keep < 1) {
+    if (keep < 1 && !rep.rigid) {  // the landmarks' rotation is well conditioned: not tapered
       const Eigen::AngleAxisd aa(Rot);
       Rot = Eigen::AngleAxisd(keep * aa.angle(), aa.axis()).toRotationMatrix();
     }
@@ -608,7 +650,7 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
       for (int v : band) in_band[v] = 1;
       handle.clear();
       for (int i = 0; i < static_cast<int>(S.from.size()); ++i)
-        if (!in_band[S.from[i]]) handle.push_back(S.from[i]);
+        if (!in_band[S.from[i]] || non_manifold[S.from[i]]) handle.push_back(S.from[i]);
       if (!handle.empty()) break;
     }
     if (handle.empty()) return skip(Status::error(StatusCode::InvalidMesh, "the part is too small for its seam band"));
@@ -617,10 +659,10 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     region.handles = {handle};
     std::vector<char> in_handle(nS, 0);
     for (int v : handle) in_handle[v] = 1;
-    for (int v : band)
-      if (!in_handle[v]) region.roi.push_back(v);
+    for (int v : band)  // a non-manifold vertex on the body side stays where it is
+      if (!in_handle[v] && !non_manifold[v]) region.roi.push_back(v);
     for (int v : sset)  // part vertices outside the submesh (no full face) move with the seam
-      if (!in_handle[v]) region.roi.push_back(v);
+      if (!in_handle[v] && !non_manifold[v]) region.roi.push_back(v);
     std::sort(region.roi.begin(), region.roi.end());
     region.roi.erase(std::unique(region.roi.begin(), region.roi.end()), region.roi.end());
     rep.seam_vertices = static_cast<int>(region.roi.size());

@@ -99,6 +99,12 @@ struct PartTransferOptions {
   // shape and says why in its report.
   bool reject_worse_parts = true;
   double max_seam_dihedral_mean = 20; // ... and leaves no seam: mean dihedral-angle change across the cut ≤ this (degrees)
+  // A part whose Transfer I folds faces (flips against its level-1 shape: different-connectivity
+  // parts with their 7–8 landmarks do) is registered rigidly instead: its level-1 shape turned
+  // about its cut's centre by the rotation that maps its landmark pairs best onto the reference
+  // part's (Kabsch), then glued and gated like any part. false: such parts go through as they
+  // are (and the gate rejects them for their flips).
+  bool rigid_when_folded = true;
   // Automatic proposals.
   int max_parts = 4;             // at most this many proposed parts (one level)
   double min_disagreement = 15;  // propose only where the disagreement exceeds this (degrees; see header)
@@ -145,7 +151,9 @@ struct PartReport {
   int subdivisions = 0;          // butterfly levels applied
   int landmarks = 0;             // landmark pairs of the part transfer (generated when same connectivity)
   int seam_vertices = 0;         // vertices smoothed by the gluing step
-  double rotation_degrees = 0;   // registration rotation (local frames)
+  double rotation_degrees = 0;   // registration rotation (local frames, or the landmarks' when rigid)
+  int transfer_flips = 0;        // faces the part's Transfer I flipped against its level-1 shape
+  bool rigid = false;            // registered rigidly instead (PartTransferOptions::rigid_when_folded)
   // Seam: |change of dihedral angle| (degrees, against the source input) across the edges that
   // join the part to the rest, mean and max, after gluing and before this part was transferred.
   double seam_dihedral_mean = 0, seam_dihedral_max = 0;

@@ -629,7 +629,7 @@ export const panel = {
         $('tr-parts-proposals').textContent = `${proposals.tried} proposal sets tried (cuts nearer and farther from the tips); set ${proposals.kept + 1} kept: landmark error ${fixed(proposals.landmarkErrorLevel1, 4)} → ${fixed(proposals.landmarkError, 4)}`;
       if (!parts) return;
       parts.parts.forEach((p, i) => {
-        let outcome = 'kept';
+        let outcome = p.rigid ? 'kept (rigid)' : 'kept';
         if (!p.ok) outcome = `skipped: ${p.message}`;
         else if (p.rejected) outcome = `rejected: ${p.message}`;
         const row = fromHtml(`<tr><td class="part-chip"></td><td></td><td>${p.level}</td><td class="outcome"></td><td>${p.sourceVertexCount}</td><td>${fixed(p.rotationDegrees, 2)}°</td></tr>`);
@@ -640,9 +640,10 @@ export const panel = {
         // the table, the rest and the timings as the row's tooltip.
         const short = p.name.replace(/\s*\(.*\)\s*$/, '') || p.name;
         row.children[1].textContent = short;
-        row.title = `${p.name}: ${p.subdivisions} subdivision(s), ${p.landmarks} landmarks, frame rotation ${fixed(p.rotationDegrees)}°, seam dihedral change mean ${fixed(p.seamDihedralMean)}° max ${fixed(p.seamDihedralMax)}°, ${fixed(p.ms / 1000)} s`;
+        const registration = p.rigid ? `its transfer folded ${p.transferFlips} faces, so it was turned rigidly onto its landmarks: rotation` : 'frame rotation';
+        row.title = `${p.name}: ${p.subdivisions} subdivision(s), ${p.landmarks} landmarks, ${registration} ${fixed(p.rotationDegrees)}°, seam dihedral change mean ${fixed(p.seamDihedralMean)}° max ${fixed(p.seamDihedralMax)}°, ${fixed(p.ms / 1000)} s`;
         row.querySelector('.outcome').textContent = outcome;
-        row.classList.toggle('rejected', outcome !== 'kept');
+        row.classList.toggle('rejected', !outcome.startsWith('kept'));
         body.append(row);
       });
     }

@@ -21,7 +21,8 @@
 //     proposal set with 'auto'), proposals {tried, kept, landmarkErrorLevel1, landmarkError}
 //     (automatic parts: how many proposal sets were transferred and which one was kept),
 //     parts: [{name, level, ok, message, rejected, sourceVertexCount,
-//     referenceVertices, subdivisions, landmarks, rotationDegrees, seamDihedralMean,
+//     referenceVertices, subdivisions, landmarks, rotationDegrees, rigid, transferFlips (a part
+//     whose own transfer folded faces is turned rigidly onto its landmarks), seamDihedralMean,
 //     seamDihedralMax, ms}] (transfer order, depth first), folds {reference, source, level1,
 //     result, flipsLevel1, flips}, ms {level1, parts, total}}
 // compare: options {slotA = 'main', slotB = 'reference'} (same vertex order); buffers
