@@ -64,6 +64,8 @@ const OptionSchema<PartTransferOptions>& transfer_part_options() {
              "--parts auto: largest part, as a fraction of the surface area");
     s.integer("proposal_sets", [](O& o) -> int& { return o.proposal_sets; }, 1, 5,
               "--parts auto: part sets tried, cut at more distances from the tips each; the one whose landmarks land closest is kept");
+    s.integer("proposal_rounds", [](O& o) -> int& { return o.proposal_rounds; }, 1, 10,
+              "--parts auto: rounds of proposals, each on the result of the one before (stops when a round brings the landmarks no closer)");
     s.number("max_seam_dihedral_mean", [](O& o) -> double& { return o.max_seam_dihedral_mean; }, 0, 180,
              "a glued part is rejected when the mean dihedral-angle change across its cut exceeds this (degrees)");
     s.boolean("rigid_when_folded", [](O& o) -> bool& { return o.rigid_when_folded; },
@@ -180,14 +182,16 @@ std::string transfer_summary(const TransferJobResult& r, const PoseTransferOptio
     s += buf;
     if (r.parts.proposals_tried > 1) {
       std::snprintf(buf, sizeof buf,
-                    "  automatic parts: %d proposal sets tried (neck windows), set %d kept: level landmark error %.4f -> %.4f\n",
-                    r.parts.proposals_tried, r.parts.proposal_kept + 1, r.parts.landmark_error_level1, r.parts.landmark_error);
+                    "  automatic parts: %d proposal sets tried (neck windows) in %d round%s, set %d of the first kept: level landmark error %.4f -> %.4f\n",
+                    r.parts.proposals_tried, std::max(1, r.parts.proposal_rounds), r.parts.proposal_rounds > 1 ? "s" : "",
+                    r.parts.proposal_kept + 1, r.parts.landmark_error_level1, r.parts.landmark_error);
       s += buf;
     }
     for (const PartReport& p : r.parts.reports) {
       std::snprintf(buf, sizeof buf,
-                    "    level %d %s: %d / %d vertices, %d subdivisions, %d landmarks, %s %.1f°, seam dihedral change mean %.1f° max %.1f°, %.0f ms%s%s\n",
-                    p.level, p.name.empty() ? "(unnamed)" : p.name.c_str(), p.source_vertices, p.reference_vertices,
+                    "    level %d%s %s: %d / %d vertices, %d subdivisions, %d landmarks, %s %.1f°, seam dihedral change mean %.1f° max %.1f°, %.0f ms%s%s\n",
+                    p.level, p.round > 1 ? (", round " + std::to_string(p.round)).c_str() : "",
+                    p.name.empty() ? "(unnamed)" : p.name.c_str(), p.source_vertices, p.reference_vertices,
                     p.subdivisions, p.landmarks, rigid_note(p).c_str(), p.rotation_degrees, p.seam_dihedral_mean, p.seam_dihedral_max, p.ms,
                     p.status.ok() ? "" : ", skipped: ", p.status.ok() ? "" : p.status.message.c_str());
       s += buf;

@@ -32,10 +32,12 @@ std::vector<LandmarkPair> load_pairs(const std::string& rel) {
 
 void print_reports(const char* what, const PartTransferResult& r) {
   for (const PartReport& p : r.reports)
-    std::printf("[ parts ] %s: level %d %-48s %s | %d/%d v, sub %d, lm %d, seam %d v, %srot %.1f°, seam Δdihedral mean %.2f° max %.1f° (before %.2f° / %.1f°), %.0f ms\n",
+    std::printf("[ parts ] %s: level %d %-48s %s | %d/%d v, sub %d, lm %d, seam %d v, %srot %.1f°, seam Δdihedral mean %.2f° max %.1f° (before %.2f° / %.1f°), %.0f ms (eigen %.0f, coupling %.0f, cage %.0f, mvc %.0f, optim %.0f, glue %.0f)\n",
                 what, p.level, p.name.c_str(), p.status.ok() ? "ok" : p.status.message.c_str(), p.source_vertices,
                 p.reference_vertices, p.subdivisions, p.landmarks, p.seam_vertices, p.rigid ? "rigid, " : "", p.rotation_degrees,
-                p.seam_dihedral_mean, p.seam_dihedral_max, p.seam_dihedral_mean_before, p.seam_dihedral_max_before, p.ms);
+                p.seam_dihedral_mean, p.seam_dihedral_max, p.seam_dihedral_mean_before, p.seam_dihedral_max_before, p.ms,
+                p.transfer_ms.eigenbases, p.transfer_ms.coupling, p.transfer_ms.cage, p.transfer_ms.mvc, p.transfer_ms.optimisation,
+                p.glue_ms);
 }
 
 }  // namespace mm::part_transfer_test

@@ -127,6 +127,7 @@ val part_transfer_js(val ref_positions, val ref_indices, val src_positions, val 
   out.set("partsJson", io::parts_json(r.parts));
   out.set("proposalsTried", r.proposals_tried);
   out.set("proposalKept", r.proposal_kept);
+  out.set("proposalRounds", r.proposal_rounds);
   out.set("landmarkErrorLevel1", r.landmark_error_level1);
   out.set("landmarkError", r.landmark_error);
   val list = val::array();
@@ -144,6 +145,7 @@ val part_transfer_js(val ref_positions, val ref_indices, val src_positions, val 
     }
     o.set("name", p.name);
     o.set("level", p.level);
+    o.set("round", p.round);
     o.set("ok", p.status.ok());
     o.set("message", p.status.message);
     o.set("sourceVertexCount", p.source_vertices);

@@ -480,22 +480,23 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     out.status = cancelled_status("part proposals");
     return out;
   }
-  // The part sets to try: the given one, or the proposals of each neck window that gives a set
-  // not seen before (PartTransferOptions::more_proposal_windows).
-  std::vector<PartsSpec> candidates;
-  if (spec) {
-    candidates.push_back(*spec);
-  } else {
-    candidates.push_back(propose_parts(reference, source, Vcur, out.level1.landmarks, opt, &out.disagreement));
+  // The part sets to try: the given one, or the proposals on `base` of each neck window that
+  // gives a set not seen before (PartTransferOptions::more_proposal_windows).
+  auto propose_sets = [&](const Eigen::MatrixXd& base, std::vector<double>* disagreement) {
+    std::vector<PartsSpec> sets;
+    sets.push_back(propose_parts(reference, source, base, out.level1.landmarks, opt, disagreement));
     for (size_t k = 0; k < opt.more_proposal_windows.size() && static_cast<int>(k) + 1 < opt.proposal_sets; ++k) {
       const PartTransferOptions::ProposalWindow& w = opt.more_proposal_windows[k];
       PartTransferOptions o = opt;
       o.neck_window_begin = w.neck_window_begin, o.neck_window_end = w.neck_window_end, o.max_part_area = w.max_part_area;
-      PartsSpec c = propose_parts(reference, source, Vcur, out.level1.landmarks, o);
-      if (std::none_of(candidates.begin(), candidates.end(), [&](const PartsSpec& x) { return part_specs_equal(x, c); }))
-        candidates.push_back(std::move(c));
+      PartsSpec c = propose_parts(reference, source, base, out.level1.landmarks, o);
+      if (std::none_of(sets.begin(), sets.end(), [&](const PartsSpec& x) { return part_specs_equal(x, c); }))
+        sets.push_back(std::move(c));
     }
-  }
+    return sets;
+  };
+  std::vector<PartsSpec> candidates = spec ? std::vector<PartsSpec>{*spec} : propose_sets(Vcur, &out.disagreement);
+  const int rounds = spec ? 1 : std::max(1, opt.proposal_rounds);
 
   const int nS = source.num_vertices(), nR = reference.num_vertices();
   const bool same_conn = nS == nR && reference.F == source.F;
@@ -509,8 +510,8 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     for (const PartPair& p : l) c += 1 + count_parts(p.children);
     return c;
   };
-  int total_parts = 0;
-  for (const PartsSpec& c : candidates) total_parts += count_parts(c.parts);
+  // Progress: the parts of round r's sets fill [0.45, 1] × (r − 1 + done / total) / rounds.
+  int total_parts = 0, round = 1;
   int done = 0;
   std::vector<PartReport>* reports = &out.reports;  // of the candidate being run
   // Running fold counts of Vcur and the level's landmark error (quality gate, see transfer_part).
@@ -532,8 +533,10 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     PartReport rep;
     rep.name = pp.name;
     rep.level = level;
-    const Progress pp_progress = progress.sub(0.45 + 0.55 * done / std::max(1, total_parts),
-                                              0.45 + 0.55 * (done + 1) / std::max(1, total_parts));
+    rep.round = round;
+    const double span = 0.55 / rounds;
+    const Progress pp_progress = progress.sub(0.45 + span * (round - 1 + double(done) / std::max(1, total_parts)),
+                                              0.45 + span * (round - 1 + double(done + 1) / std::max(1, total_parts)));
     ++done;
     std::vector<int> sset, rset;
     if (Status s = part_vertices(source.V, source.F, pp.source, &sset); !s.ok())
@@ -744,33 +747,54 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     }
     return Status::success();
   };
-  // Each candidate from the level-1 result; the one whose level landmark pairs end closest to the
-  // reference is kept. Within `proposal_tie` (relative) of the best so far counts as a tie, which
-  // the earlier candidate wins: near-equal sets are told apart by the last bits of the part
-  // transfers, which differ between builds (docs/transfer.md).
+  // Each candidate from the round's base (level 1 in the first round); the one whose level
+  // landmark pairs end closest to the reference is kept. Within `proposal_tie` (relative) of the
+  // best so far counts as a tie, which the earlier candidate (or round) wins: near-equal sets are
+  // told apart by the last bits of the part transfers, which differ between builds
+  // (docs/transfer.md). Every kept part passed the gate, so no round moves the landmarks away.
   out.landmark_error_level1 = lm_error(out.V_level1);
-  const int si_level1 = si_current, flips_level1 = flips_current;
+  out.V = out.V_level1;
+  out.landmark_error = out.landmark_error_level1;
   double best = std::numeric_limits<double>::infinity();
-  for (size_t c = 0; c < candidates.size(); ++c) {
-    Vcur = out.V_level1;
-    si_current = si_level1, flips_current = flips_level1;
-    std::vector<PartReport> tried;
-    reports = &tried;
-    if (Status s = run_level(candidates[c].parts, 2); !s.ok()) {
-      out.status = s;
-      return out;
+  for (; round <= rounds; ++round) {
+    if (round > 1) candidates = propose_sets(out.V, nullptr);
+    total_parts = 0;
+    for (const PartsSpec& c : candidates) total_parts += count_parts(c.parts);
+    done = 0;
+    const Eigen::MatrixXd base = out.V;
+    const int si_base = si_current, flips_base = flips_current;
+    int kept = -1, si_kept = si_base, flips_kept = flips_base;
+    Eigen::MatrixXd V_kept;
+    std::vector<PartReport> reports_kept;
+    for (size_t c = 0; c < candidates.size(); ++c) {
+      Vcur = base;
+      si_current = si_base, flips_current = flips_base;
+      std::vector<PartReport> tried;
+      reports = &tried;
+      if (Status s = run_level(candidates[c].parts, 2); !s.ok()) {
+        out.status = s;
+        return out;
+      }
+      const double e = lm_error(Vcur);
+      // The first set of the first round always stands (a NaN error included).
+      if ((round == 1 && c == 0) || e < best * (1 - opt.proposal_tie)) {
+        best = e;
+        kept = static_cast<int>(c);
+        V_kept = Vcur;
+        reports_kept = std::move(tried);
+        si_kept = si_current, flips_kept = flips_current;
+      }
     }
-    const double e = lm_error(Vcur);
-    if (c == 0 || e < best * (1 - opt.proposal_tie)) {  // the first set always stands (a NaN error included)
-      best = e;
-      out.V = Vcur;
-      out.reports = std::move(tried);
-      out.parts = candidates[c];
-      out.proposal_kept = static_cast<int>(c);
-      out.landmark_error = e;
-    }
+    out.proposals_tried += spec ? 0 : static_cast<int>(candidates.size());
+    if (kept < 0) break;  // no set of this round lands closer: the rounds are over
+    out.V = V_kept;
+    out.landmark_error = best;
+    for (PartReport& r : reports_kept) out.reports.push_back(std::move(r));
+    for (const PartPair& p : candidates[kept].parts) out.parts.parts.push_back(p);
+    if (round == 1) out.proposal_kept = kept;
+    out.proposal_rounds = round;
+    si_current = si_kept, flips_current = flips_kept;
   }
-  out.proposals_tried = spec ? 0 : static_cast<int>(candidates.size());
   out.ms_parts = part_ms_since(t_parts);
   out.folds = fold_report(reference, source, out.V);
   out.ms_total = part_ms_since(t_start);

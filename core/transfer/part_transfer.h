@@ -50,7 +50,8 @@
 // edit, or pass back. part_transfer with automatic parts proposes with several neck windows
 // (more_proposal_windows), transfers each distinct set from the level-1 result and keeps the
 // set whose level landmark pairs end closest to the reference (on the ten same-connectivity
-// pairs measured, the summed gain went from 25 to 123 percentage points natively).
+// pairs measured, the summed gain went from 25 to 123 percentage points natively), then
+// proposes again on that result (proposal_rounds; docs/transfer.md has the measurements).
 // Experimental: measured on the Sumner/TOSCA pairs only (docs/transfer.md).
 //
 // Quality gate (reject_worse_parts): a glued part is kept only if the result keeps within the
@@ -127,6 +128,12 @@ struct PartTransferOptions {
   std::vector<ProposalWindow> more_proposal_windows = {{1.25, 2.5, 0.3}, {1.5, 3.0, 0.3}, {1.25, 2.5, 0.4}, {1.5, 3.0, 0.4}};
   int proposal_sets = 5;         // at most this many sets: the window above, then more_proposal_windows in order (1 = one set)
   double proposal_tie = 0.01;    // a later set must end ≥ this fraction closer to be kept instead
+  // Rounds of proposals (automatic parts only): after a round keeps its best set, the disagreement
+  // is measured again on that result and new sets are proposed, each run after the parts kept so
+  // far; a round is kept when its best set lands ≥ proposal_tie closer, and the rounds stop at the
+  // first that does not. The parts of all kept rounds run one after the other from level 1, so
+  // the parts file written (--parts-out) gives the same result. 1 = one round.
+  int proposal_rounds = 3;
 };
 
 struct FoldReport {
@@ -152,6 +159,7 @@ struct PartReport {
   int landmarks = 0;             // landmark pairs of the part transfer (generated when same connectivity)
   int seam_vertices = 0;         // vertices smoothed by the gluing step
   double rotation_degrees = 0;   // registration rotation (local frames, or the landmarks' when rigid)
+  int round = 1;                 // automatic parts: the proposal round that gave it
   int transfer_flips = 0;        // faces the part's Transfer I flipped against its level-1 shape
   bool rigid = false;            // registered rigidly instead (PartTransferOptions::rigid_when_folded)
   // Seam: |change of dihedral angle| (degrees, against the source input) across the edges that
@@ -182,6 +190,7 @@ struct PartTransferResult {
   // the one kept (0 = the first window), and the level landmark pairs' aligned error of level 1
   // and of the result.
   int proposals_tried = 0, proposal_kept = 0;
+  int proposal_rounds = 0;       // rounds that kept a set (PartTransferOptions::proposal_rounds)
   double landmark_error_level1 = 0, landmark_error = 0;
   double ms_level1 = 0, ms_parts = 0, ms_total = 0;
 };

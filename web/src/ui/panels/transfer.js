@@ -626,13 +626,13 @@ export const panel = {
       const proposals = parts?.proposals;
       $('tr-parts-proposals').hidden = !(proposals?.tried > 1);
       if (proposals?.tried > 1)
-        $('tr-parts-proposals').textContent = `${proposals.tried} proposal sets tried (cuts nearer and farther from the tips); set ${proposals.kept + 1} kept: landmark error ${fixed(proposals.landmarkErrorLevel1, 4)} → ${fixed(proposals.landmarkError, 4)}`;
+        $('tr-parts-proposals').textContent = `${proposals.tried} proposal sets tried (cuts nearer and farther from the tips) in ${proposals.rounds > 1 ? `${proposals.rounds} rounds, each on the result of the one before` : '1 round'}; set ${proposals.kept + 1} of the first kept: landmark error ${fixed(proposals.landmarkErrorLevel1, 4)} → ${fixed(proposals.landmarkError, 4)}`;
       if (!parts) return;
       parts.parts.forEach((p, i) => {
         let outcome = p.rigid ? 'kept (rigid)' : 'kept';
         if (!p.ok) outcome = `skipped: ${p.message}`;
         else if (p.rejected) outcome = `rejected: ${p.message}`;
-        const row = fromHtml(`<tr><td class="part-chip"></td><td></td><td>${p.level}</td><td class="outcome"></td><td>${p.sourceVertexCount}</td><td>${fixed(p.rotationDegrees, 2)}°</td></tr>`);
+        const row = fromHtml(`<tr><td class="part-chip"></td><td></td><td>${p.level}${p.round > 1 ? ` (round ${p.round})` : ''}</td><td class="outcome"></td><td>${p.sourceVertexCount}</td><td>${fixed(p.rotationDegrees, 2)}°</td></tr>`);
         const chip = row.querySelector('.part-chip');
         chip.textContent = String(i + 1);
         chip.style.background = `rgb(${pairColor(i).map((v) => Math.round(255 * v)).join(', ')})`;
@@ -654,7 +654,7 @@ export const panel = {
       const mode = $('tr-parts').value;
       transfer.parts = mode;
       let hint = '';
-      if (mode === 'auto') hint = 'After the whole-body transfer, parts where the pose still disagrees most (limbs, head, tail) are proposed with cuts at several distances from their tips, transferred again and glued back, and the set whose landmarks land closest to the reference is kept; a part that would add folds, flips or a seam is rejected. Save parts gives the parts used, to edit.';
+      if (mode === 'auto') hint = 'After the whole-body transfer, parts where the pose still disagrees most (limbs, head, tail) are proposed with cuts at several distances from their tips, transferred again and glued back, and the set whose landmarks land closest to the reference is kept; then parts are proposed again on that result, for up to 3 rounds; a part that would add folds, flips or a seam is rejected. Save parts gives the parts used, to edit.';
       else if (mode === 'file') hint = `${transfer.partsFile.count} part pair${transfer.partsFile.count === 1 ? '' : 's'} from ${transfer.partsFile.name}.`;
       $('tr-parts-hint').textContent = hint;
       if (partForm) partForm.element.hidden = mode === 'none';

@@ -18,9 +18,9 @@
 //   → buffers {positions (final, welded #V·3), positionsLevel1, partLabels: Int32Array (per
 //     welded source vertex the index of the deepest part that contains it, -1 outside)}
 //     info {level1: the transfer op's info for level 1, partsJson (the parts used: the kept
-//     proposal set with 'auto'), proposals {tried, kept, landmarkErrorLevel1, landmarkError}
+//     proposal set with 'auto'), proposals {tried, kept, rounds, landmarkErrorLevel1, landmarkError}
 //     (automatic parts: how many proposal sets were transferred and which one was kept),
-//     parts: [{name, level, ok, message, rejected, sourceVertexCount,
+//     parts: [{name, level, round, ok, message, rejected, sourceVertexCount,
 //     referenceVertices, subdivisions, landmarks, rotationDegrees, rigid, transferFlips (a part
 //     whose own transfer folded faces is turned rigidly onto its landmarks), seamDihedralMean,
 //     seamDihedralMax, ms}] (transfer order, depth first), folds {reference, source, level1,
@@ -92,7 +92,7 @@ export const ops = {
       info: {
         level1: poseInfo(r.level1),
         partsJson: r.partsJson,
-        proposals: { tried: r.proposalsTried, kept: r.proposalKept, landmarkErrorLevel1: r.landmarkErrorLevel1, landmarkError: r.landmarkError },
+        proposals: { tried: r.proposalsTried, kept: r.proposalKept, rounds: r.proposalRounds, landmarkErrorLevel1: r.landmarkErrorLevel1, landmarkError: r.landmarkError },
         parts: r.parts.map(({ sourceVertices, ...p }) => p),
         folds: r.folds,
         ms: r.ms,
