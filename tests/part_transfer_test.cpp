@@ -205,12 +205,13 @@ TEST(PartRegions, DiskPlaneAndErrors) {
 // Measured (docs/transfer.md has the table): the gate (PartTransferOptions::reject_worse_parts)
 // keeps a part only if it adds no flipped face, keeps the self-intersections within the
 // reference + source bound, leaves no seam and does not move the generated landmark pairs away
-// from the reference; automatic parts try up to five proposal sets (neck windows) and keep the
-// one whose landmarks land closest. Issue 16 asks for a lower aligned error than one level on
-// every pair and ≥ 35% lower where limbs move: natively cat-05 −52 %, lion-05 −28 %, cat-01 −16 %,
-// cat-07 −10 %, horse15 −8 %, lion-07 −6.5 %; lion-01 is 10.7 % worse (its parts lower the 30
-// landmarks' error, 0.072 → 0.065, but not the vertex error). The builds pick different sets
-// where two come close (lion-05 in wasm: −1.0 %), so the bounds below hold both.
+// from the reference; automatic parts try up to five proposal sets (neck windows) per round,
+// keep the one whose landmarks land closest, and propose again on that result (up to three
+// rounds). Issue 16 asks for a lower aligned error than one level on every pair and ≥ 35% lower
+// where limbs move. Measured native / wasm: cat-05 −59 / −58 %, lion-05 −50 / −53 %, lion-01
+// −25 / −23 %, cat-07 −23 / −18 %, cat-01 −16 / −27 %, horse15 −8.7 / −48 %, lion-07 −6.4 /
+// −8.8 %. The builds pick different sets and gate decisions where two come close (their part
+// transfers differ in the last bits), so the bounds below hold both, with ~10 % margin.
 struct PartPairCase {
   const char* pose;
   const char* rest;
@@ -224,6 +225,10 @@ TEST_P(PartTransferSame, TwoLevelsAgainstOneLevel) {
   const PartPairCase& c = GetParam();
   if (!std::filesystem::exists(test::data_path(c.pose)) || !std::filesystem::exists(test::data_path(c.rest)))
     GTEST_SKIP() << "not in this checkout: " << c.pose << " (held-out pairs come from ../shared/data)";
+#ifdef __EMSCRIPTEN__
+  if (std::string(c.pose).rfind("../", 0) == 0)
+    GTEST_SKIP() << "held-out pairs run natively only (the wasm suite's time on the CI machine)";
+#endif
   const Mesh P = test::load_mesh(c.pose), S = test::load_mesh(c.rest);
   const PartTransferResult r = part_transfer(P, S, {}, nullptr);
   ASSERT_TRUE(r.status.ok()) << r.status.message;
@@ -251,7 +256,7 @@ TEST_P(PartTransferSame, TwoLevelsAgainstOneLevel) {
     EXPECT_LT(p.seam_dihedral_max, 150.0) << p.name;
   }
   // Deterministic: a second run is bit-identical (checked on the quickest pair only).
-  if (std::string(c.pose) == "pose/lion-05.ply") {
+  if (std::string(c.pose) == "pose/lion-07.ply") {
     const PartTransferResult again = part_transfer(P, S, {}, nullptr);
     EXPECT_TRUE(again.V == r.V) << "two runs differ";
   }
@@ -270,11 +275,11 @@ std::string pair_case_name(const testing::TestParamInfo<PartPairCase>& info) {
 // builds + margin.
 INSTANTIATE_TEST_SUITE_P(Pairs, PartTransferSame,
                          testing::Values(PartPairCase{"pose/cat-01.ply", "pose/cat-reference.ply", true, 0.056},
-                                         PartPairCase{"pose/cat-05.ply", "pose/cat-reference.ply", true, 0.030},
-                                         PartPairCase{"pose/cat-07.ply", "pose/cat-reference.ply", true, 0.080},
-                                         PartPairCase{"pose/lion-01.ply", "pose/lion-reference.ply", false, 0.063},
-                                         PartPairCase{"pose/lion-05.ply", "pose/lion-reference.ply", true, 0.040},
-                                         PartPairCase{"pose/lion-07.ply", "pose/lion-reference.ply", true, 0.097},
+                                         PartPairCase{"pose/cat-05.ply", "pose/cat-reference.ply", true, 0.026},
+                                         PartPairCase{"pose/cat-07.ply", "pose/cat-reference.ply", true, 0.074},
+                                         PartPairCase{"pose/lion-01.ply", "pose/lion-reference.ply", true, 0.048},
+                                         PartPairCase{"pose/lion-05.ply", "pose/lion-reference.ply", true, 0.022},
+                                         PartPairCase{"pose/lion-07.ply", "pose/lion-reference.ply", true, 0.096},
                                          PartPairCase{"pose/horse15.ply", "pose/horse0.ply", true, 0.044}),
                          pair_case_name);
 
@@ -287,10 +292,10 @@ TEST(PartTransferDifferent, CatToLionHorseToCamelMichaelToArmadillo) {
     double max_landmark_ratio;  // two levels / one level, measured + margin
   };
   // michael9 (52,565 vertices) comes from ../shared/data: skipped without it.
-  for (const Case& c : {Case{"pose/cat-01.ply", "pose/lion-reference.ply", "landmarks/cat-lion.json", "pose/lion-01.ply", 0.85},
-                        Case{"pose/horse0.ply", "pose/camel_ref.ply", "landmarks/horse0-camel_ref.json", nullptr, 0.97},
+  for (const Case& c : {Case{"pose/cat-01.ply", "pose/lion-reference.ply", "landmarks/cat-lion.json", "pose/lion-01.ply", 0.75},
+                        Case{"pose/horse0.ply", "pose/camel_ref.ply", "landmarks/horse0-camel_ref.json", nullptr, 0.95},
                         Case{"../../shared/data/pose/tosca/michael9.off", "edit/armadillo.ply", "landmarks/michael3-armadillo.json",
-                             nullptr, 0.98}}) {
+                             nullptr, 0.97}}) {
     if (!std::filesystem::exists(test::data_path(c.ref))) {
       std::printf("[ parts ] %s not in this checkout (../shared/data): skipped\n", c.ref);
       continue;
@@ -326,11 +331,11 @@ TEST(PartTransferDifferent, CatToLionHorseToCamelMichaelToArmadillo) {
               std::max(r.folds.self_intersections_reference + r.folds.self_intersections_source,
                        r.folds_level1.self_intersections_result));
     // Issue 16: a lower landmark error than one level. The parts' own transfers fold here (7–9
-    // landmarks per part), so the parts that are kept are the rigidly turned ones
-    // (rigid_when_folded). Measured natively: cat → lion −19 % (ground truth −23 %), horse →
-    // camel −5.0 %, michael → armadillo −3.7 %.
+    // landmarks per part), so most parts that are kept are the rigidly turned ones
+    // (rigid_when_folded). Measured (native / wasm): cat → lion −31 % / −31 % (ground truth
+    // −37 % / −31 %), horse → camel −8.2 % / −8.4 %, michael → armadillo −5.3 % / −5.3 %.
     EXPECT_LE(l2, c.max_landmark_ratio * l1);
-    if (c.gt) EXPECT_LE(g2, 0.85 * g1);  // lion-01: Sumner's own transfer of cat-01, never seen by the method
+    if (c.gt) EXPECT_LE(g2, 0.75 * g1);  // lion-01: Sumner's own transfer of cat-01, never seen by the method
   }
 }
 
@@ -406,7 +411,7 @@ TEST(PartTransferJob, NestedPartsFromAFile) {
 // closer by its landmarks, 17 % lower error, is within proposal_tie of the first set, which
 // keeps no part there). Skipped in a fresh clone without ../shared.
 INSTANTIATE_TEST_SUITE_P(HeldOut, PartTransferSame,
-                         testing::Values(PartPairCase{"../../shared/data/pose/sumner/horse-03.obj", "../../shared/data/pose/sumner/horse_ref.obj", true, 0.052},
-                                         PartPairCase{"../../shared/data/pose/sumner/horse-07.obj", "../../shared/data/pose/sumner/horse_ref.obj", true, 0.046},
+                         testing::Values(PartPairCase{"../../shared/data/pose/sumner/horse-03.obj", "../../shared/data/pose/sumner/horse_ref.obj", true, 0.034},
+                                         PartPairCase{"../../shared/data/pose/sumner/horse-07.obj", "../../shared/data/pose/sumner/horse_ref.obj", true, 0.024},
                                          PartPairCase{"../../shared/data/pose/tosca/michael9.off", "../../shared/data/pose/tosca/michael3.off", false, 0.058}),
                          pair_case_name);
