@@ -135,7 +135,7 @@ const markup = `
     <div id="tr-parts-result" hidden>
       <div class="row"><label title="Each part's region in its own colour on the source side"><input type="checkbox" id="tr-part-colours" checked /> Colour the parts</label></div>
       <p id="tr-parts-proposals" class="hint" hidden></p>
-      <table class="landmarks parts"><thead><tr><th>#</th><th>part</th><th>level</th><th>result</th><th>vertices</th><th title="registration by the local frames (Sec. 4.3)">rotation</th></tr></thead><tbody></tbody></table>
+      <table class="landmarks parts"><thead><tr><th>#</th><th>part</th><th title="part level; r2, r3: proposed in the second or third round">level</th><th>result</th><th>vertices</th><th title="registration by the local frames (Sec. 4.3), or by the part's landmarks when kept rigid">rotation</th></tr></thead><tbody></tbody></table>
     </div>
   </div>
 </section>`;
@@ -629,10 +629,12 @@ export const panel = {
         $('tr-parts-proposals').textContent = `${proposals.tried} proposal sets tried (cuts nearer and farther from the tips) in ${proposals.rounds > 1 ? `${proposals.rounds} rounds, each on the result of the one before` : '1 round'}; set ${proposals.kept + 1} of the first kept: landmark error ${fixed(proposals.landmarkErrorLevel1, 4)} → ${fixed(proposals.landmarkError, 4)}`;
       if (!parts) return;
       parts.parts.forEach((p, i) => {
+        // The cell says what happened; why (the core's message) is in the row's tooltip, so that
+        // the table stays one line per part.
         let outcome = p.rigid ? 'kept (rigid)' : 'kept';
-        if (!p.ok) outcome = `skipped: ${p.message}`;
-        else if (p.rejected) outcome = `rejected: ${p.message}`;
-        const row = fromHtml(`<tr><td class="part-chip"></td><td></td><td>${p.level}${p.round > 1 ? ` (round ${p.round})` : ''}</td><td class="outcome"></td><td>${p.sourceVertexCount}</td><td>${fixed(p.rotationDegrees, 2)}°</td></tr>`);
+        if (p.rejected) outcome = 'rejected';
+        else if (!p.ok) outcome = 'skipped';
+        const row = fromHtml(`<tr><td class="part-chip"></td><td></td><td>${p.level}${p.round > 1 ? ` r${p.round}` : ''}</td><td class="outcome"></td><td>${p.sourceVertexCount}</td><td>${fixed(p.rotationDegrees, 2)}°</td></tr>`);
         const chip = row.querySelector('.part-chip');
         chip.textContent = String(i + 1);
         chip.style.background = `rgb(${pairColor(i).map((v) => Math.round(255 * v)).join(', ')})`;
@@ -641,7 +643,7 @@ export const panel = {
         const short = p.name.replace(/\s*\(.*\)\s*$/, '') || p.name;
         row.children[1].textContent = short;
         const registration = p.rigid ? `its transfer folded ${p.transferFlips} faces, so it was turned rigidly onto its landmarks: rotation` : 'frame rotation';
-        row.title = `${p.name}: ${p.subdivisions} subdivision(s), ${p.landmarks} landmarks, ${registration} ${fixed(p.rotationDegrees)}°, seam dihedral change mean ${fixed(p.seamDihedralMean)}° max ${fixed(p.seamDihedralMax)}°, ${fixed(p.ms / 1000)} s`;
+        row.title = `${p.name}: ${p.ok ? '' : `${p.message.replace(/^rejected: /, '')}. `}${p.subdivisions} subdivision(s), ${p.landmarks} landmarks, ${registration} ${fixed(p.rotationDegrees)}°, seam dihedral change mean ${fixed(p.seamDihedralMean)}° max ${fixed(p.seamDihedralMax)}°, ${fixed(p.ms / 1000)} s`;
         row.querySelector('.outcome').textContent = outcome;
         row.classList.toggle('rejected', !outcome.startsWith('kept'));
         body.append(row);
