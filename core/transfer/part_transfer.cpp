@@ -433,9 +433,9 @@ PartsSpec propose_parts(const Mesh& reference, const Mesh& source, const Eigen::
     for (int v : blob) taken[v] = 1;
     for (int v = 0; v < n; ++v)
       if (dt[v] < std::max(radius, r_blob) * 1.15) taken[v] = 1;
+    if (!(radius > 0) || tip_ref < 0) continue;
     int inside = 0;
     for (int v = 0; v < n; ++v) inside += dt[v] < radius;
-    if (!(radius > 0) || tip_ref < 0) continue;
     if (inside < opt.min_part_fraction * n) continue;  // too small to carry a pose of its own
     PartPair pp;
     char name[96];
@@ -587,59 +587,59 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     rep.transfer_flips = transfer_metrics(T, S.V, S.F).flipped_faces;
     // Step 4: registration, rotation about the boundary centroid, then the boundary centroid onto
     // the level-1 one. By the paper's local frames; or rigidly (the level-1 shape turned onto the
-    // part's landmarks) when the transfer folded faces. Returns false when no rotation exists.
-    auto register_part = [&](bool rigid, Eigen::MatrixXd* Treg, double* degrees) {
-      const Eigen::MatrixXd& X = rigid ? S.V : T;  // rigid: the level-1 shape
-      Eigen::Matrix3d Rot;
-      if (!rigid) {
-        bool axis_t = false, axis_r = false;
-        const Eigen::Matrix3d Et = part_frame(X, S.boundary, S.tip, &axis_t);
-        const Eigen::Matrix3d Er = part_frame(R.V, R.boundary, R.tip, &axis_r);
-        if (axis_t || axis_r) Rot = Eigen::Quaterniond::FromTwoVectors(Et.col(0), Er.col(0)).toRotationMatrix();
-        else Rot = Er * Et.transpose();
+    // part's landmarks) when the transfer folded faces.
+    rep.rigid = opt.rigid_when_folded && rep.transfer_flips > 0;
+    const Eigen::MatrixXd& X = rep.rigid ? S.V : T;  // rigid: the level-1 shape
+    Eigen::Matrix3d Rot;
+    if (!rep.rigid) {
+      bool axis_t = false, axis_r = false;
+      const Eigen::Matrix3d Et = part_frame(X, S.boundary, S.tip, &axis_t);
+      const Eigen::Matrix3d Er = part_frame(R.V, R.boundary, R.tip, &axis_r);
+      if (axis_t || axis_r) Rot = Eigen::Quaterniond::FromTwoVectors(Et.col(0), Er.col(0)).toRotationMatrix();
+      else Rot = Er * Et.transpose();
+    } else {
+      // The rotation that best maps the part's landmark pairs (every vertex when the part pair
+      // has one connectivity), each taken from its part's cut centre (Umeyama, with scale: the
+      // meshes differ in size).
+      Eigen::MatrixXd P, Q;
+      if (same_pair) {
+        P = S.V, Q = R.V;
       } else {
-        // The rotation that best maps the part's landmark pairs (every vertex when the part pair
-        // has one connectivity), each taken from its part's cut centre (Umeyama, with scale: the
-        // meshes differ in size).
-        Eigen::MatrixXd P, Q;
-        if (same_pair) {
-          P = S.V, Q = R.V;
-        } else {
-          P.resize(static_cast<Eigen::Index>(lm.size()), 3), Q.resize(static_cast<Eigen::Index>(lm.size()), 3);
-          for (size_t k = 0; k < lm.size(); ++k) {
-            P.row(static_cast<Eigen::Index>(k)) = S.V.row(lm[k].source);
-            Q.row(static_cast<Eigen::Index>(k)) = R.V.row(lm[k].reference);
-          }
+        P.resize(static_cast<Eigen::Index>(lm.size()), 3), Q.resize(static_cast<Eigen::Index>(lm.size()), 3);
+        for (size_t k = 0; k < lm.size(); ++k) {
+          P.row(static_cast<Eigen::Index>(k)) = S.V.row(lm[k].source);
+          Q.row(static_cast<Eigen::Index>(k)) = R.V.row(lm[k].reference);
         }
-        P.rowwise() -= part_boundary_centroid(S.V, S.boundary).transpose();
-        Q.rowwise() -= part_boundary_centroid(R.V, R.boundary).transpose();
-        RigidFitOptions ro;
-        ro.scale = true;
-        ro.rotation_prior = 0.01;  // landmarks along a limb say little about the turn about it: none then
-        const RigidFit fit = fit_rigid(P, Q, ro);
-        if (fit.degenerate) return false;
-        Rot = fit.R;
       }
-      *degrees = Eigen::AngleAxisd(Rot).angle() * 180.0 / M_PI;
-      // Transfer I already gives the part the reference part's orientation (the low frequencies
-      // carry it), so a large frame rotation means an ill-conditioned frame (a short or straight
-      // part whose average point lies near the axis): measured up to 167° on cat-07/cat-05 parts,
-      // all rejected by the gate below. Such rotations are not applied: the rotation is tapered
-      // from full at max_registration_degrees − 15° to none at + 15° (a hard cut made the result
-      // jump with the last bits of the estimate: cat-01's second part measured 46.1° natively and
-      // 43.0° in wasm, one side of the cut each). The landmarks' rotation is well conditioned.
-      const double taper_lo = opt.max_registration_degrees - 15, taper_hi = opt.max_registration_degrees + 15;
-      const double keep = std::clamp((taper_hi - *degrees) / (taper_hi - taper_lo), 0.0, 1.0);
-      if (keep < 1 && !rigid) {
-        const Eigen::AngleAxisd aa(Rot);
-        Rot = Eigen::AngleAxisd(keep * aa.angle(), aa.axis()).toRotationMatrix();
-      }
-      const Eigen::Vector3d bt = part_boundary_centroid(X, S.boundary);
-      const Eigen::Vector3d bs = part_boundary_centroid(S.V, S.boundary);
-      Treg->resize(X.rows(), 3);
-      for (int i = 0; i < X.rows(); ++i) Treg->row(i) = (Rot * (X.row(i).transpose() - bt) + bs).transpose();
-      return true;
-    };
+      P.rowwise() -= part_boundary_centroid(S.V, S.boundary).transpose();
+      Q.rowwise() -= part_boundary_centroid(R.V, R.boundary).transpose();
+      RigidFitOptions ro;
+      ro.scale = true;
+      ro.rotation_prior = 0.01;  // landmarks along a limb say little about the turn about it: none then
+      const RigidFit fit = fit_rigid(P, Q, ro);
+      if (fit.degenerate)
+        return skip(Status::error(StatusCode::InvalidArgument, "its transfer folded " + std::to_string(rep.transfer_flips) +
+                                                                  " faces, and its landmarks are too few to turn it rigidly"));
+      Rot = fit.R;
+    }
+    rep.rotation_degrees = Eigen::AngleAxisd(Rot).angle() * 180.0 / M_PI;
+    // Transfer I already gives the part the reference part's orientation (the low frequencies
+    // carry it), so a large frame rotation means an ill-conditioned frame (a short or straight
+    // part whose average point lies near the axis): measured up to 167° on cat-07/cat-05 parts,
+    // all rejected by the gate below. Such rotations are not applied: the rotation is tapered
+    // from full at max_registration_degrees − 15° to none at + 15° (a hard cut made the result
+    // jump with the last bits of the estimate: cat-01's second part measured 46.1° natively and
+    // 43.0° in wasm, one side of the cut each). The landmarks' rotation is well conditioned.
+    const double taper_lo = opt.max_registration_degrees - 15, taper_hi = opt.max_registration_degrees + 15;
+    const double keep = std::clamp((taper_hi - rep.rotation_degrees) / (taper_hi - taper_lo), 0.0, 1.0);
+    if (keep < 1 && !rep.rigid) {
+      const Eigen::AngleAxisd aa(Rot);
+      Rot = Eigen::AngleAxisd(keep * aa.angle(), aa.axis()).toRotationMatrix();
+    }
+    const Eigen::Vector3d bt = part_boundary_centroid(X, S.boundary);
+    const Eigen::Vector3d bs = part_boundary_centroid(S.V, S.boundary);
+    Eigen::MatrixXd Treg(X.rows(), 3);
+    for (int i = 0; i < X.rows(); ++i) Treg.row(i) = (Rot * (X.row(i).transpose() - bt) + bs).transpose();
     // Step 5: gluing. Free: `seam_rings` rings around the cut on both sides; handle: the
     // part's other vertices at their registered positions; the rest of the mesh stays.
     std::vector<char> in_part(nS, 0);
@@ -681,54 +681,43 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
       if (s.code == StatusCode::Cancelled) return s;
       return skip(Status::error(s.code, "gluing: " + s.message));
     }
-    // Glues a registration and runs the quality gate: keep the part only if it brings the
-    // level's landmark pairs closer to the reference (after a similarity fit) and adds no
-    // self-intersection and no flipped face. Fills rep's measures; *why: the gate's objections.
-    EditResult fin;
-    int si_after = 0, flips_after = 0;
-    auto glue = [&](const Eigen::MatrixXd& Treg, std::string* why) -> Status {
-      Eigen::MatrixXd targets = Vcur;
-      for (int i = 0; i < static_cast<int>(S.from.size()); ++i) targets.row(S.from[i]) = Treg.row(i);
-      EditResult d = editor.drag_positions(targets);
-      if (!d.status.ok()) return Status::error(d.status.code, "gluing: " + d.status.message);
-      fin = editor.finalize(FeatureSize::Keep);
-      if (!fin.status.ok()) return Status::error(fin.status.code, "gluing: " + fin.status.message);
-      if (!fin.V.allFinite()) return Status::error(StatusCode::NumericalError, "gluing produced non-finite positions");
-      si_after = self_intersections(fin.V, source.F).pairs;
-      flips_after = transfer_metrics(fin.V, source.V, source.F).flipped_faces;
-      rep.landmark_error_before = lm_error(Vcur);
-      rep.landmark_error_after = lm_error(fin.V);
-      rep.self_intersections_added = si_after - si_current;
-      rep.flips_added = flips_after - flips_current;
-      part_seam_dihedral(fin.V, source.V, source.F, in_part, &rep.seam_dihedral_mean, &rep.seam_dihedral_max);
-      rep.seam_dihedral_mean_before = l1_mean;
-      rep.seam_dihedral_max_before = l1_max;
-      why->clear();
-      if (!opt.reject_worse_parts) return Status::success();
+    Eigen::MatrixXd targets = Vcur;
+    for (int i = 0; i < static_cast<int>(S.from.size()); ++i) targets.row(S.from[i]) = Treg.row(i);
+    EditResult d = editor.drag_positions(targets);
+    if (!d.status.ok()) return skip(Status::error(d.status.code, "gluing: " + d.status.message));
+    EditResult fin = editor.finalize(FeatureSize::Keep);
+    if (!fin.status.ok()) return skip(Status::error(fin.status.code, "gluing: " + fin.status.message));
+    if (!fin.V.allFinite()) return skip(Status::error(StatusCode::NumericalError, "gluing produced non-finite positions"));
+    // Quality gate: keep the part only if it brings the level's landmark pairs closer to the
+    // reference (after a similarity fit), adds no self-intersection and no flipped face, and
+    // leaves no seam.
+    const int si_after = self_intersections(fin.V, source.F).pairs;
+    const int flips_after = transfer_metrics(fin.V, source.V, source.F).flipped_faces;
+    rep.landmark_error_before = lm_error(Vcur);
+    rep.landmark_error_after = lm_error(fin.V);
+    rep.self_intersections_added = si_after - si_current;
+    rep.flips_added = flips_after - flips_current;
+    part_seam_dihedral(fin.V, source.V, source.F, in_part, &rep.seam_dihedral_mean, &rep.seam_dihedral_max);
+    rep.seam_dihedral_mean_before = l1_mean;
+    rep.seam_dihedral_max_before = l1_max;
+    if (opt.reject_worse_parts) {
+      std::string why;
       // Issue 16's bound: no more self-intersecting pairs than the reference and the source
       // together (the Sumner poses themselves have 40–1565: limbs pressed against the body).
       const int si_bound = std::max(si_current, out.folds_level1.self_intersections_reference +
                                                     out.folds_level1.self_intersections_source);
       if (si_after > si_bound)
-        *why += ", adds " + std::to_string(si_after - si_current) + " self-intersecting pairs (bound " +
-                std::to_string(si_bound) + ")";
-      if (flips_after > flips_current) *why += ", adds " + std::to_string(flips_after - flips_current) + " flipped faces";
-      if (rep.landmark_error_after > rep.landmark_error_before) *why += ", moves the landmarks away from the reference";
+        why += ", adds " + std::to_string(si_after - si_current) + " self-intersecting pairs (bound " +
+               std::to_string(si_bound) + ")";
+      if (flips_after > flips_current) why += ", adds " + std::to_string(flips_after - flips_current) + " flipped faces";
+      if (rep.landmark_error_after > rep.landmark_error_before) why += ", moves the landmarks away from the reference";
       if (rep.seam_dihedral_mean > opt.max_seam_dihedral_mean)
-        *why += ", leaves a seam (mean dihedral change " + std::to_string(static_cast<int>(std::lround(rep.seam_dihedral_mean))) +
-                "° across the cut)";
-      return Status::success();
-    };
-    rep.rigid = opt.rigid_when_folded && rep.transfer_flips > 0;
-    Eigen::MatrixXd Treg;
-    if (!register_part(rep.rigid, &Treg, &rep.rotation_degrees))
-      return skip(Status::error(StatusCode::InvalidArgument, "its transfer folded " + std::to_string(rep.transfer_flips) +
-                                                                " faces, and its landmarks are too few to turn it rigidly"));
-    std::string why;
-    if (Status s = glue(Treg, &why); !s.ok()) return skip(s);
-    if (!why.empty()) {
-      rep.rejected = true;
-      return skip(Status::error(StatusCode::NotConverged, "rejected: the glued part" + why.substr(1)));
+        why += ", leaves a seam (mean dihedral change " + std::to_string(static_cast<int>(std::lround(rep.seam_dihedral_mean))) +
+               "° across the cut)";
+      if (!why.empty()) {
+        rep.rejected = true;
+        return skip(Status::error(StatusCode::NotConverged, "rejected: the glued part" + why.substr(1)));
+      }
     }
     si_current = si_after;
     flips_current = flips_after;
