@@ -70,6 +70,10 @@ const OptionSchema<PartTransferOptions>& transfer_part_options() {
              "a glued part is rejected when the mean dihedral-angle change across its cut exceeds this (degrees)");
     s.boolean("rigid_when_folded", [](O& o) -> bool& { return o.rigid_when_folded; },
               "a part whose own transfer folds faces is turned rigidly onto its landmarks instead");
+    s.boolean("reuse_level_cage", [](O& o) -> bool& { return o.reuse_level_cage; },
+              "a part takes the level-1 deformed cage, far cage vertices held (paper 000 Sec. 5), where that cage still encloses it");
+    s.number("reused_cage_fixed_weight", [](O& o) -> double& { return o.reused_cage_fixed_weight; }, 0, 1,
+             "with --reuse-level-cage: the cage vertices carrying the least of the part's mean-value weight, up to this fraction of it, are held");
     return s;
   }();
   return schema;
@@ -80,6 +84,11 @@ namespace {
 std::string rigid_note(const PartReport& p) {
   if (!p.rigid) return "rotation";
   return "rigid (its transfer folded " + std::to_string(p.transfer_flips) + " faces), rotation";
+}
+
+// ", level-1 cage (N vertices held)" when the part's transfer reused the level-1 cage.
+std::string cage_note(const PartReport& p) {
+  return p.cage_reused ? ", level-1 cage (" + std::to_string(p.fixed_cage_vertices) + " vertices held)" : "";
 }
 
 TransferJobResult transfer_job_failure(Status s) {
@@ -189,10 +198,10 @@ std::string transfer_summary(const TransferJobResult& r, const PoseTransferOptio
     }
     for (const PartReport& p : r.parts.reports) {
       std::snprintf(buf, sizeof buf,
-                    "    level %d%s %s: %d / %d vertices, %d subdivisions, %d landmarks, %s %.1f°, seam dihedral change mean %.1f° max %.1f°, %.0f ms%s%s\n",
+                    "    level %d%s %s: %d / %d vertices, %d subdivisions, %d landmarks%s, %s %.1f°, seam dihedral change mean %.1f° max %.1f°, %.0f ms%s%s\n",
                     p.level, p.round > 1 ? (", round " + std::to_string(p.round)).c_str() : "",
                     p.name.empty() ? "(unnamed)" : p.name.c_str(), p.source_vertices, p.reference_vertices,
-                    p.subdivisions, p.landmarks, rigid_note(p).c_str(), p.rotation_degrees, p.seam_dihedral_mean, p.seam_dihedral_max, p.ms,
+                    p.subdivisions, p.landmarks, cage_note(p).c_str(), rigid_note(p).c_str(), p.rotation_degrees, p.seam_dihedral_mean, p.seam_dihedral_max, p.ms,
                     p.status.ok() ? "" : ", skipped: ", p.status.ok() ? "" : p.status.message.c_str());
       s += buf;
     }

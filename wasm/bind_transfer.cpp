@@ -155,6 +155,8 @@ val part_transfer_js(val ref_positions, val ref_indices, val src_positions, val 
     o.set("rotationDegrees", p.rotation_degrees);
     o.set("rigid", p.rigid);
     o.set("transferFlips", p.transfer_flips);
+    o.set("cageReused", p.cage_reused);
+    o.set("fixedCageVertices", p.fixed_cage_vertices);
     o.set("seamDihedralMean", p.seam_dihedral_mean);
     o.set("seamDihedralMax", p.seam_dihedral_max);
     o.set("rejected", p.rejected);

@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include "cage/enclosing_cage.h"
 #include "linalg/rigid_fit.h"
 #include "merge/cut.h"
 #include "mesh/butterfly.h"
@@ -575,7 +576,15 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     topt.cage.resolution = opt.part_cage_resolution;
     topt.placement = TransferPlacement::Reference;
     Mesh Sm{Ssub.V, Ssub.F}, Rm{Rsub.V, Rsub.F};
-    const PoseTransferResult t = pose_transfer(Rm, Sm, lm, topt, pp_progress.sub(0.0, 0.8));
+    // The level-1 cage where it still encloses the part (paper 000 Sec. 5), else its own.
+    Mesh level_cage;
+    if (opt.reuse_level_cage && out.level1.cage_deformed.rows() > 0) {
+      level_cage = Mesh{out.level1.cage_deformed, out.level1.cage_faces};
+      rep.cage_reused = check_user_cage(Sm.V, level_cage.V, &level_cage.F, topt.cage.min_clearance * 1e-3).ok();
+      if (rep.cage_reused) topt.fixed_cage_weight = opt.reused_cage_fixed_weight;
+    }
+    const PoseTransferResult t = pose_transfer(Rm, Sm, lm, topt, pp_progress.sub(0.0, 0.8), rep.cage_reused ? &level_cage : nullptr);
+    rep.fixed_cage_vertices = t.fixed_cage_vertices;
     if (t.status.code == StatusCode::Cancelled) return t.status;
     rep.landmarks = static_cast<int>(t.landmarks.size());
     rep.transfer_ms = t.ms;

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <numeric>
 #include <algorithm>
 #include <cmath>
 
@@ -297,6 +298,22 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
     prob.CF = CF;
     prob.P = PhiK_src.transpose() * src.mass.asDiagonal() * cs.Psi;  // Eq. 8: Φ̂_Kᵀ A Ψ
     prob.T = alpha_ref;
+    if (opt.fixed_cage_weight > 0) {
+      // The lightest cage vertices held, in normalized coordinates (where the optimisation runs).
+      const Eigen::VectorXd w = cs.Psi.cwiseAbs().transpose() * src.mass;
+      std::vector<int> order(static_cast<size_t>(w.size()));
+      std::iota(order.begin(), order.end(), 0);
+      std::stable_sort(order.begin(), order.end(), [&w](int x, int y) { return w[x] < w[y]; });
+      double held = 0;
+      for (int c : order) {
+        if ((held += w[c]) > opt.fixed_cage_weight * w.sum()) break;
+        prob.fixed.push_back(c);
+      }
+      std::sort(prob.fixed.begin(), prob.fixed.end());
+      prob.fixed_positions.resize(static_cast<Eigen::Index>(prob.fixed.size()), 3);
+      for (size_t f = 0; f < prob.fixed.size(); ++f) prob.fixed_positions.row(static_cast<Eigen::Index>(f)) = Cn.row(prob.fixed[f]);
+      out.fixed_cage_vertices = static_cast<int>(prob.fixed.size());
+    }
     const CagePoseResult sol = solve_cage_pose(prob, opt.solver, progress.sub(0.85, 1.0));
     if (!sol.status.ok()) {
       out.status = sol.status;

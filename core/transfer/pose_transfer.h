@@ -75,6 +75,13 @@ struct PoseTransferOptions {
   EnclosingCageOptions cage = pose_transfer_cage_options(); // automatic cage, ~450 vertices (below)
   CagePoseOptions solver;        // λ₁ = λ₂ = 0.05, re-linearization tolerance
   TransferPlacement placement = TransferPlacement::Reference;
+  // With a given cage (part transfer reuses the level before's deformed cage): the cage vertices
+  // that matter least to the source keep their positions during the optimisation (paper 000
+  // Sec. 5: "we always fix those cage vertices that are far away from the part to be
+  // processed"). A cage vertex's weight is Σ_i a_i |Ψ_ij| over the source's vertices (area a_i);
+  // the lightest vertices whose weights add up to at most this fraction of the total are held.
+  // 0: every cage vertex is free.
+  double fixed_cage_weight = 0;
 };
 
 struct PoseTransferTimings {     // wall-clock milliseconds per stage (informational)
@@ -94,6 +101,7 @@ struct PoseTransferResult {
   Eigen::MatrixXd cage_rest;       // #C by 3 cage in source coordinates (Yin only)
   Eigen::MatrixXd cage_deformed;   // #C by 3 deformed cage, output coordinates (Yin only)
   Eigen::MatrixXi cage_faces;      // cage triangles
+  int fixed_cage_vertices = 0;     // cage vertices held by fixed_cage_weight (Yin only)
   int iterations = 0;              // re-linearizations of the cage solve (Yin only)
   bool converged = true;           // cage solve reached its tolerance (Yin only)
   std::vector<double> energy;      // Eq. 12 energy after each iteration (Yin only)

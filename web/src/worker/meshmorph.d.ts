@@ -174,7 +174,8 @@ export type Op = (ctx: OpContext, options: object, buffers: Buffers) => { buffer
 //            vertex, -1 outside)} / {level1 (as transfer's info), partsJson, proposals: {tried,
 //            kept, rounds, landmarkErrorLevel1, landmarkError} (automatic parts: proposal sets
 //            tried over how many rounds, and the first round's set kept), parts: [{name, level,
-//            round, ok, message, rejected, rigid, transferFlips, ...}], folds, ms}
+//            round, ok, message, rejected, rigid, transferFlips, cageReused,
+//            fixedCageVertices, ...}], folds, ms}
 //            (hierarchical part transfer, paper 000 Sec. 4.3)
 // ---- edit ops (ops/edit.js): positions results carry {positions, rawPositions, rawNormals}
 // ---- debug ops (ops/debug.js; the e2e recovery checks only)

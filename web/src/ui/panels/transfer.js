@@ -643,7 +643,7 @@ export const panel = {
         const short = p.name.replace(/\s*\(.*\)\s*$/, '') || p.name;
         row.children[1].textContent = short;
         const registration = p.rigid ? `its transfer folded ${p.transferFlips} faces, so it was turned rigidly onto its landmarks: rotation` : 'frame rotation';
-        row.title = `${p.name}: ${p.ok ? '' : `${p.message.replace(/^rejected: /, '')}. `}${p.subdivisions} subdivision(s), ${p.landmarks} landmarks, ${registration} ${fixed(p.rotationDegrees)}°, seam dihedral change mean ${fixed(p.seamDihedralMean)}° max ${fixed(p.seamDihedralMax)}°, ${fixed(p.ms / 1000)} s`;
+        row.title = `${p.name}: ${p.ok ? '' : `${p.message.replace(/^rejected: /, '')}. `}${p.subdivisions} subdivision(s), ${p.landmarks} landmarks, ${p.cageReused ? `level-1 cage (${p.fixedCageVertices} of its vertices held)` : 'own cage'}, ${registration} ${fixed(p.rotationDegrees)}°, seam dihedral change mean ${fixed(p.seamDihedralMean)}° max ${fixed(p.seamDihedralMax)}°, ${fixed(p.ms / 1000)} s`;
         row.querySelector('.outcome').textContent = outcome;
         row.classList.toggle('rejected', !outcome.startsWith('kept'));
         body.append(row);

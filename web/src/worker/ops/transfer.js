@@ -22,7 +22,9 @@
 //     (automatic parts: how many proposal sets were transferred and which one was kept),
 //     parts: [{name, level, round, ok, message, rejected, sourceVertexCount,
 //     referenceVertices, subdivisions, landmarks, rotationDegrees, rigid, transferFlips (a part
-//     whose own transfer folded faces is turned rigidly onto its landmarks), seamDihedralMean,
+//     whose own transfer folded faces is turned rigidly onto its landmarks), cageReused,
+//     fixedCageVertices (its transfer ran in the level-1 cage, this many cage vertices held),
+//     seamDihedralMean,
 //     seamDihedralMax, ms}] (transfer order, depth first), folds {reference, source, level1,
 //     result, flipsLevel1, flips}, ms {level1, parts, total}}
 // compare: options {slotA = 'main', slotB = 'reference'} (same vertex order); buffers
