@@ -207,16 +207,19 @@ TEST(PartRegions, DiskPlaneAndErrors) {
 // reference + source bound, leaves no seam and does not move the generated landmark pairs away
 // from the reference; automatic parts try up to five proposal sets (neck windows) per round,
 // keep the one whose landmarks land closest, and propose again on that result (up to three
-// rounds); each part's transfer runs in the level-1 cage where that still encloses it. Issue 16
-// asks for a lower aligned error than one level on every pair and ≥ 35% lower where limbs move.
-// Measured native / wasm: cat-05 −60 / −60 %, lion-05 −51 / −50 %, lion-01 −25 / −29 %, cat-07
-// −23 / −18 %, cat-01 −14 / −17 %, horse15 −10 / −51 %, lion-07 −6.4 / −8.8 %. The builds pick different sets and gate decisions where two come close (their part
+// rounds, six parts a set); each part's transfer runs in the level-1 cage where that still
+// encloses it. Issue 16 asks for a lower aligned error than one level on every pair and ≥ 35%
+// lower where limbs move. Measured native / wasm: cat-05 −57 / −59 %, cat-01 −44 / −41 %, cat-07
+// −42 / −44 %, horse15 −41 / −43 %, lion-05 −42 / −43 %, lion-01 −31 / −37 %, lion-07 −6.4 /
+// −8.8 % (a lion lying with folded legs: level 1 stretches them, and the parts proposed there
+// fold or leave a seam). The 35 % is asserted where both builds reach it. The builds pick different sets and gate decisions where two come close (their part
 // transfers differ in the last bits), so the bounds below hold both, with ~10 % margin.
 struct PartPairCase {
   const char* pose;
   const char* rest;
   bool improves;         // two levels have a lower aligned error than one (asserted)
   double max_error;      // two-level aligned error, measured + margin
+  double min_gain = 0;   // 1 − two levels / one level at least this (issue 16's 35 % where both builds reach it)
 };
 
 class PartTransferSame : public testing::TestWithParam<PartPairCase> {};
@@ -241,6 +244,7 @@ TEST_P(PartTransferSame, TwoLevelsAgainstOneLevel) {
               r.ms_level1, r.ms_parts);
   part_transfer_test::print_reports(c.pose, r);
   if (c.improves) EXPECT_LT(e2, e1);
+  EXPECT_GE(1 - e2 / e1, c.min_gain);
   EXPECT_LT(e2, c.max_error);
   // No flips beyond level 1's, no self-intersections beyond the bound (or level 1's count).
   EXPECT_LE(m2.flipped_faces, m1.flipped_faces);
@@ -274,13 +278,13 @@ std::string pair_case_name(const testing::TestParamInfo<PartPairCase>& info) {
 // improves: two levels asserted lower than one (native and wasm); max_error: measured in both
 // builds + margin.
 INSTANTIATE_TEST_SUITE_P(Pairs, PartTransferSame,
-                         testing::Values(PartPairCase{"pose/cat-01.ply", "pose/cat-reference.ply", true, 0.056},
-                                         PartPairCase{"pose/cat-05.ply", "pose/cat-reference.ply", true, 0.026},
-                                         PartPairCase{"pose/cat-07.ply", "pose/cat-reference.ply", true, 0.074},
-                                         PartPairCase{"pose/lion-01.ply", "pose/lion-reference.ply", true, 0.048},
-                                         PartPairCase{"pose/lion-05.ply", "pose/lion-reference.ply", true, 0.022},
+                         testing::Values(PartPairCase{"pose/cat-01.ply", "pose/cat-reference.ply", true, 0.041, 0.35},
+                                         PartPairCase{"pose/cat-05.ply", "pose/cat-reference.ply", true, 0.025, 0.35},
+                                         PartPairCase{"pose/cat-07.ply", "pose/cat-reference.ply", true, 0.054, 0.35},
+                                         PartPairCase{"pose/lion-01.ply", "pose/lion-reference.ply", true, 0.043},
+                                         PartPairCase{"pose/lion-05.ply", "pose/lion-reference.ply", true, 0.024, 0.35},
                                          PartPairCase{"pose/lion-07.ply", "pose/lion-reference.ply", true, 0.096},
-                                         PartPairCase{"pose/horse15.ply", "pose/horse0.ply", true, 0.044}),
+                                         PartPairCase{"pose/horse15.ply", "pose/horse0.ply", true, 0.029, 0.35}),
                          pair_case_name);
 
 // ---------------------------------------------------------------------------------------------
@@ -332,8 +336,8 @@ TEST(PartTransferDifferent, CatToLionHorseToCamelMichaelToArmadillo) {
                        r.folds_level1.self_intersections_result));
     // Issue 16: a lower landmark error than one level. The parts' own transfers fold here (7–9
     // landmarks per part), so most parts that are kept are the rigidly turned ones
-    // (rigid_when_folded). Measured (native / wasm): cat → lion −31 % / −31 % (ground truth
-    // −37 % / −31 %), horse → camel −8.2 % / −8.4 %, michael → armadillo −3.8 % / −3.8 % (−5.3 % with a cage per part).
+    // (rigid_when_folded). Measured (native / wasm): cat → lion −33 % / −31 % (ground truth
+    // −41 % / −37 %), horse → camel −8.2 % / −8.4 %, michael → armadillo −7.1 % / −7.2 %.
     EXPECT_LE(l2, c.max_landmark_ratio * l1);
     if (c.gt) EXPECT_LE(g2, 0.75 * g1);  // lion-01: Sumner's own transfer of cat-01, never seen by the method
   }
@@ -407,11 +411,10 @@ TEST(PartTransferJob, NestedPartsFromAFile) {
 
 // Held out: the same-connectivity pairs of ../shared/data that the repository does not carry
 // (Sumner's horse, TOSCA's michael at 52k vertices). The proposal windows were chosen on the
-// pairs above; these check them on others (one round: horse-03 −11 %, horse-07 −3 %; three
-// rounds in the level-1 cage: −55 %, −53 %; michael9: every part it proposes folds or moves the
-// landmarks away, so it keeps none). Skipped in a fresh clone without ../shared.
+// pairs above; these check them on others (one round, four parts: horse-03 −11 %, horse-07 −3 %,
+// michael9 0; three rounds of six parts in the level-1 cage: −52 %, −61 %, −26 %). Skipped in a fresh clone without ../shared.
 INSTANTIATE_TEST_SUITE_P(HeldOut, PartTransferSame,
-                         testing::Values(PartPairCase{"../../shared/data/pose/sumner/horse-03.obj", "../../shared/data/pose/sumner/horse_ref.obj", true, 0.034},
-                                         PartPairCase{"../../shared/data/pose/sumner/horse-07.obj", "../../shared/data/pose/sumner/horse_ref.obj", true, 0.024},
-                                         PartPairCase{"../../shared/data/pose/tosca/michael9.off", "../../shared/data/pose/tosca/michael3.off", false, 0.058}),
+                         testing::Values(PartPairCase{"../../shared/data/pose/sumner/horse-03.obj", "../../shared/data/pose/sumner/horse_ref.obj", true, 0.029, 0.35},
+                                         PartPairCase{"../../shared/data/pose/sumner/horse-07.obj", "../../shared/data/pose/sumner/horse_ref.obj", true, 0.020, 0.35},
+                                         PartPairCase{"../../shared/data/pose/tosca/michael9.off", "../../shared/data/pose/tosca/michael3.off", true, 0.047}),
                          pair_case_name);
