@@ -304,9 +304,10 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
       std::vector<int> order(static_cast<size_t>(w.size()));
       std::iota(order.begin(), order.end(), 0);
       std::stable_sort(order.begin(), order.end(), [&w](int x, int y) { return w[x] < w[y]; });
+      const double budget = opt.fixed_cage_weight * w.sum();
       double held = 0;
       for (int c : order) {
-        if ((held += w[c]) > opt.fixed_cage_weight * w.sum()) break;
+        if ((held += w[c]) > budget) break;
         prob.fixed.push_back(c);
       }
       std::sort(prob.fixed.begin(), prob.fixed.end());
