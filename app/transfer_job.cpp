@@ -31,6 +31,8 @@ const OptionSchema<PoseTransferOptions>& transfer_options() {
               "size of the automatic cage (Table 1: 166-520)");
     s.integer("cage_resolution", [](O& o) -> int& { return o.cage.resolution; }, 8, 1024,
               "offset grid cells along the longest side for the automatic cage");
+    s.integer("fold_retry_resolution", [](O& o) -> int& { return o.fold_retry_resolution; }, 0, 1024,
+              "when the result flips faces or self-intersects more than the inputs together, build the automatic cage again on this finer grid and keep the result with fewer folds (0: off)");
     s.integer("max_iterations", [](O& o) -> int& { return o.solver.max_iterations; }, 1, 10000,
               "re-linearizations of the cage solve");
     s.number("tolerance", [](O& o) -> double& { return o.solver.tolerance; }, 0, 1,
@@ -148,7 +150,7 @@ TransferJobResult run_transfer_job(const TransferJobFiles& files, const PoseTran
     r.transfer = pose_transfer(reference, source, pairs, options, progress, files.cage.empty() ? nullptr : &cage);
     if (!(r.status = r.transfer.status).ok()) return r;
     result = r.transfer.V;
-    r.folds = fold_report(reference, source, result);
+    r.folds = r.transfer.fold_retry.checked ? r.transfer.folds : fold_report(reference, source, result);
     if (!files.parts_out.empty()) {
       PartTransferOptions po = part_options;
       po.transfer = options;
@@ -183,6 +185,16 @@ std::string transfer_summary(const TransferJobResult& r, const PoseTransferOptio
                 "\n  time: eigenbases %.0f ms, coupling %.0f ms, cage %.0f ms, MVC %.0f ms, optimisation %.0f ms, total %.0f ms\n",
                 t.ms.eigenbases, t.ms.coupling, t.ms.cage, t.ms.mvc, t.ms.optimisation, t.ms.total);
   s += buf;
+  const FoldRetry& retry = r.hierarchical ? r.parts.fold_retry : t.fold_retry;
+  if (retry.tried) {
+    const FoldReport& a = retry.first;
+    std::snprintf(buf, sizeof buf,
+                  "  %s on a %d-cell cage grid (the first result had %d flipped faces, %d self-intersecting pairs against %d in the inputs): %s, %.0f ms\n",
+                  r.hierarchical ? "level 1 and parts again" : "cage rebuilt", retry.resolution, a.flipped_faces,
+                  a.self_intersections_result, a.self_intersections_reference + a.self_intersections_source,
+                  retry.kept ? "kept" : "not kept (no fewer folds)", retry.ms);
+    s += buf;
+  }
   if (r.hierarchical) {
     size_t kept = 0;
     for (const PartReport& p : r.parts.reports) kept += p.status.ok();

@@ -220,6 +220,7 @@ struct PartPairCase {
   bool improves;         // two levels have a lower aligned error than one (asserted)
   double max_error;      // two-level aligned error, measured + margin
   double min_gain = 0;   // 1 − two levels / one level at least this (issue 16's 35 % where both builds reach it)
+  bool no_flips = true;  // the two-level result flips no face against the source
 };
 
 class PartTransferSame : public testing::TestWithParam<PartPairCase> {};
@@ -237,11 +238,12 @@ TEST_P(PartTransferSame, TwoLevelsAgainstOneLevel) {
   ASSERT_TRUE(r.status.ok()) << r.status.message;
   const double e1 = aligned_vertex_error(r.V_level1, P.V), e2 = aligned_vertex_error(r.V, P.V);
   const TransferMetrics m1 = transfer_metrics(r.V_level1, S.V, S.F), m2 = transfer_metrics(r.V, S.V, S.F);
-  std::printf("[ parts ] %s -> %s: aligned error level 1 %.4f, two levels %.4f (%.1f%% lower) | flips %d -> %d | self-intersections ref %d src %d level1 %d result %d | %zu parts | %.0f + %.0f ms\n",
+  std::printf("[ parts ] %s -> %s: aligned error level 1 %.4f, two levels %.4f (%.1f%% lower) | flips %d -> %d | self-intersections ref %d src %d level1 %d result %d | %zu parts | %.0f + %.0f ms%s\n",
               c.pose, c.rest, e1, e2, 100 * (1 - e2 / e1), m1.flipped_faces, m2.flipped_faces,
               r.folds.self_intersections_reference, r.folds.self_intersections_source,
               r.folds_level1.self_intersections_result, r.folds.self_intersections_result, r.reports.size(),
-              r.ms_level1, r.ms_parts);
+              r.ms_level1, r.ms_parts,
+              r.fold_retry.tried ? (r.fold_retry.kept ? " | second pass on the finer cage grid kept" : " | second pass not kept") : "");
   part_transfer_test::print_reports(c.pose, r);
   if (c.improves) EXPECT_LT(e2, e1);
   EXPECT_GE(1 - e2 / e1, c.min_gain);
@@ -260,11 +262,15 @@ TEST_P(PartTransferSame, TwoLevelsAgainstOneLevel) {
     EXPECT_LT(p.seam_dihedral_max, 150.0) << p.name;
   }
   // Parts run in the level-1 cage (paper 000 Sec. 5) where it still encloses them, with some of
-  // that cage's vertices held.
-  EXPECT_TRUE(std::any_of(r.reports.begin(), r.reports.end(),
-                          [](const PartReport& p) { return p.cage_reused && p.fixed_cage_vertices > 0; }));
-  // Deterministic: a second run is bit-identical (checked on the quickest pair only).
-  if (std::string(c.pose) == "pose/lion-07.ply") {
+  // that cage's vertices held. (Not asserted after the fold retry: its finer, tighter level-1
+  // cage encloses few subdivided parts — lion-07's second pass reuses it for none.)
+  if (!r.fold_retry.kept)
+    EXPECT_TRUE(std::any_of(r.reports.begin(), r.reports.end(),
+                            [](const PartReport& p) { return p.cage_reused && p.fixed_cage_vertices > 0; }));
+  // Issue 16: no flips. michael9 → michael3 keeps 128 (level 1 has them on either cage grid).
+  if (c.no_flips) EXPECT_EQ(m2.flipped_faces, 0);
+  // Deterministic: a second run is bit-identical (checked on one of the quicker pairs only).
+  if (std::string(c.pose) == "pose/cat-05.ply") {
     const PartTransferResult again = part_transfer(P, S, {}, nullptr);
     EXPECT_TRUE(again.V == r.V) << "two runs differ";
   }
@@ -287,12 +293,51 @@ INSTANTIATE_TEST_SUITE_P(Pairs, PartTransferSame,
                                          PartPairCase{"pose/cat-07.ply", "pose/cat-reference.ply", true, 0.054, 0.35},
                                          PartPairCase{"pose/lion-01.ply", "pose/lion-reference.ply", true, 0.043},
                                          PartPairCase{"pose/lion-05.ply", "pose/lion-reference.ply", true, 0.024, 0.35},
-                                         PartPairCase{"pose/lion-07.ply", "pose/lion-reference.ply", true, 0.096},
+                                         PartPairCase{"pose/lion-07.ply", "pose/lion-reference.ply", true, 0.087},
                                          PartPairCase{"pose/horse15.ply", "pose/horse0.ply", true, 0.029, 0.35}),
                          pair_case_name);
 
 // ---------------------------------------------------------------------------------------------
 // Different connectivity.
+
+// Issue 16's "no folds" at the whole-body step. horse0 → camel_ref folds on the default 80-cell
+// cage grid: the offset (3 voxels) and the decimation to 450 vertices bridge the gap between each
+// pair of the camel's legs, so a leg's mean-value coordinates lean on cage vertices across the
+// gap and the optimisation pulls the feet into each other (the front and hind feet cross: 366
+// self-intersecting pairs, the inputs 293). On the 128-cell grid (fold_retry_resolution) the
+// thinner offset keeps the legs apart (145). docs/transfer.md, "Folds at level 1".
+TEST(TransferFolds, HorseToCamelCageOnAFinerGrid) {
+  const Mesh R = test::load_mesh("pose/horse0.ply"), S = test::load_mesh("pose/camel_ref.ply");
+  const auto pairs = part_transfer_test::load_pairs("landmarks/horse0-camel_ref.json");
+  PoseTransferOptions off;
+  off.fold_retry_resolution = 0;
+  const PoseTransferResult a = pose_transfer(R, S, pairs, off);
+  ASSERT_TRUE(a.status.ok()) << a.status.message;
+  EXPECT_FALSE(a.fold_retry.checked);
+  const FoldReport fa = fold_report(R, S, a.V);
+  EXPECT_TRUE(fa.new_folds()) << fa.self_intersections_result;  // the cause, on the usual grid
+  const PoseTransferResult b = pose_transfer(R, S, pairs);
+  ASSERT_TRUE(b.status.ok()) << b.status.message;
+  EXPECT_TRUE(b.fold_retry.checked && b.fold_retry.tried && b.fold_retry.kept);
+  EXPECT_EQ(b.fold_retry.first.self_intersections_result, fa.self_intersections_result);
+  const FoldReport fb = fold_report(R, S, b.V);
+  EXPECT_EQ(fb.self_intersections_result, b.folds.self_intersections_result);
+  EXPECT_FALSE(fb.new_folds()) << fb.self_intersections_result;
+  EXPECT_EQ(fb.flipped_faces, 0);
+  EXPECT_EQ(b.cage_rest.rows(), a.cage_rest.rows());  // the same cage size, on the finer grid
+  // The landmarks land about as close (measured 0.0501 → 0.0515 of the diagonal, aligned).
+  Eigen::MatrixXd La(pairs.size(), 3), Lb(pairs.size(), 3), LR(pairs.size(), 3);
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    La.row(k) = a.V.row(pairs[k].source);
+    Lb.row(k) = b.V.row(pairs[k].source);
+    LR.row(k) = R.V.row(pairs[k].reference);
+  }
+  const double ea = aligned_vertex_error(La, LR), eb = aligned_vertex_error(Lb, LR);
+  std::printf("[ folds ] horse0 -> camel_ref: self-intersections %d -> %d (inputs %d), landmark error %.4f -> %.4f, retry %.0f ms\n",
+              fa.self_intersections_result, fb.self_intersections_result,
+              fa.self_intersections_reference + fa.self_intersections_source, ea, eb, b.fold_retry.ms);
+  EXPECT_LT(eb, 1.1 * ea);
+}
 
 TEST(PartTransferDifferent, CatToLionHorseToCamelMichaelToArmadillo) {
   struct Case {
@@ -420,5 +465,5 @@ TEST(PartTransferJob, NestedPartsFromAFile) {
 INSTANTIATE_TEST_SUITE_P(HeldOut, PartTransferSame,
                          testing::Values(PartPairCase{"../../shared/data/pose/sumner/horse-03.obj", "../../shared/data/pose/sumner/horse_ref.obj", true, 0.029, 0.35},
                                          PartPairCase{"../../shared/data/pose/sumner/horse-07.obj", "../../shared/data/pose/sumner/horse_ref.obj", true, 0.020, 0.35},
-                                         PartPairCase{"../../shared/data/pose/tosca/michael9.off", "../../shared/data/pose/tosca/michael3.off", true, 0.047}),
+                                         PartPairCase{"../../shared/data/pose/tosca/michael9.off", "../../shared/data/pose/tosca/michael3.off", true, 0.047, 0, false}),
                          pair_case_name);

@@ -10,6 +10,9 @@
 //     → {ok, positions: Float64Array (#V·3), gamma: Float64Array (k·k, row-major), k,
 //        gammaDominance, iterations, converged, couplingIterations, cagePositions: Float64Array,
 //        cageRest: Float64Array, cageIndices: Uint32Array, energy: Float64Array,
+//        foldRetry: {tried, kept, resolution, firstFlips, firstSelfIntersections,
+//                    inputSelfIntersections, ms} (PoseTransferOptions::fold_retry_resolution: the
+//                    first result folded, the cage was built again on the finer grid),
 //        ms: {eigenbases, coupling, cage, mvc, optimisation, total}}
 //   partTransfer(refPositions, refIndices, srcPositions, srcIndices, landmarks, parts, options?,
 //                partOptions?, progress?)   hierarchical part transfer (paper 000 Sec. 4.3, issue 16)
@@ -23,6 +26,8 @@
 //                 rotationDegrees, seamDihedralMean, seamDihedralMax, rejected, ms}],
 //        folds: {reference, source, level1, result, flipsLevel1, flips} (self-intersecting
 //                triangle pairs; flipped faces against the source),
+//        foldRetry: as poseTransfer's, for the whole two-level run (level 1 and its parts again
+//                   on the finer cage grid when the first result folds),
 //        ms: {level1, parts, total}}
 //   transferMetrics(positionsA (#V·3), positionsB (#V·3), indices (#F·3))
 //     → {ok, vertexErrorMean, vertexErrorMax, laplacianChange, edgeDistortionMean,
@@ -45,6 +50,19 @@ using emscripten::val;
 
 namespace {
 
+// PoseTransferOptions::fold_retry_resolution's record (pose or part transfer).
+val fold_retry_object(const FoldRetry& f) {
+  val o = val::object();
+  o.set("tried", f.tried);
+  o.set("kept", f.kept);
+  o.set("resolution", f.resolution);
+  o.set("firstFlips", f.first.flipped_faces);
+  o.set("firstSelfIntersections", f.first.self_intersections_result);
+  o.set("inputSelfIntersections", f.first.self_intersections_reference + f.first.self_intersections_source);
+  o.set("ms", f.ms);
+  return o;
+}
+
 // The level-1 fields of a pose transfer result (poseTransfer's, and partTransfer's `level1`).
 void set_pose_fields(val& out, const PoseTransferResult& r) {
   Eigen::MatrixXd g = r.gamma;
@@ -58,6 +76,7 @@ void set_pose_fields(val& out, const PoseTransferResult& r) {
   out.set("cageRest", to_float64_array(r.cage_rest));
   out.set("cageIndices", to_uint32_array(r.cage_faces));
   out.set("energy", to_float64_array(Eigen::Map<const Eigen::MatrixXd>(r.energy.data(), r.energy.size(), 1)));
+  out.set("foldRetry", fold_retry_object(r.fold_retry));
   val ms = val::object();
   ms.set("eigenbases", r.ms.eigenbases);
   ms.set("coupling", r.ms.coupling);
@@ -172,6 +191,7 @@ val part_transfer_js(val ref_positions, val ref_indices, val src_positions, val 
   folds.set("flipsLevel1", r.folds_level1.flipped_faces);
   folds.set("flips", r.folds.flipped_faces);
   out.set("folds", folds);
+  out.set("foldRetry", fold_retry_object(r.fold_retry));
   val level1 = val::object();
   set_pose_fields(level1, r.level1);
   out.set("level1", level1);

@@ -1,6 +1,7 @@
 #include "transfer/part_transfer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <functional>
@@ -268,15 +269,6 @@ bool part_specs_equal(const PartsSpec& a, const PartsSpec& b) { return part_list
 
 using namespace part_detail;
 
-FoldReport fold_report(const Mesh& reference, const Mesh& source, const Eigen::MatrixXd& result) {
-  FoldReport r;
-  r.self_intersections_reference = self_intersections(reference.V, reference.F).pairs;
-  r.self_intersections_source = self_intersections(source.V, source.F).pairs;
-  r.self_intersections_result = self_intersections(result, source.F).pairs;
-  r.flipped_faces = transfer_metrics(result, source.V, source.F).flipped_faces;
-  return r;
-}
-
 Status part_vertices(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const PartRegion& region,
                      std::vector<int>* vertices) {
   vertices->clear();
@@ -459,8 +451,13 @@ PartsSpec propose_parts(const Mesh& reference, const Mesh& source, const Eigen::
   return spec;
 }
 
-PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, const std::vector<LandmarkPair>& landmarks,
-                                 const PartsSpec* spec, const PartTransferOptions& opt, const Progress& progress) {
+namespace {
+
+// Level 1 (opt.transfer, whose own fold retry is off) and the parts on it. *level1_folds (if
+// given) is set once level 1 is known to fold, before the parts report progress.
+PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, const std::vector<LandmarkPair>& landmarks,
+                                   const PartsSpec* spec, const PartTransferOptions& opt, const Progress& progress,
+                                   std::atomic<bool>* level1_folds = nullptr) {
   using clock = std::chrono::steady_clock;
   const auto t_start = clock::now();
   PartTransferResult out;
@@ -475,7 +472,8 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
   if (!(out.status = out.level1.status).ok()) return out;
   out.V_level1 = out.level1.V;
   Eigen::MatrixXd Vcur = out.V_level1;
-  out.folds_level1 = fold_report(reference, source, Vcur);
+  out.folds_level1 = out.level1.fold_retry.checked ? out.level1.folds : fold_report(reference, source, Vcur);
+  if (level1_folds) level1_folds->store(out.folds_level1.violations() > 0);
   const auto t_parts = clock::now();
   if (!progress.update("part proposals", 0.42)) {
     out.status = cancelled_status("part proposals");
@@ -574,6 +572,7 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     PoseTransferOptions topt = opt.transfer;
     topt.cage.target_vertices = opt.part_cage_vertices;
     topt.cage.resolution = opt.part_cage_resolution;
+    topt.fold_retry_resolution = 0;  // the part gate checks folds itself
     topt.placement = TransferPlacement::Reference;
     Mesh Sm{Ssub.V, Ssub.F}, Rm{Rsub.V, Rsub.F};
     // The level-1 cage where it still encloses the part (paper 000 Sec. 5), else its own.
@@ -795,6 +794,52 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
   }
   out.ms_parts = part_ms_since(t_parts);
   out.folds = fold_report(reference, source, out.V);
+  out.ms_total = part_ms_since(t_start);
+  progress.update("done", 1.0);
+  return out;
+}
+
+}  // namespace
+
+PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, const std::vector<LandmarkPair>& landmarks,
+                                 const PartsSpec* spec, const PartTransferOptions& opt, const Progress& progress) {
+  const auto t_start = std::chrono::steady_clock::now();
+  // No folds (PoseTransferOptions::fold_retry_resolution), decided on the final result: the
+  // level-1 cage on the finer grid only when the parts on the usual one end with folds. The
+  // parts often repair level 1's (cat-07's one flipped face; horse0 → camel_ref's feet), and on
+  // the finer, tighter cage fewer parts fit inside the reused level-1 cage.
+  const int finer = opt.transfer.fold_retry_resolution;
+  const bool may_retry = finer > opt.transfer.cage.resolution;
+  PartTransferOptions first = opt;
+  first.transfer.fold_retry_resolution = 0;
+  // The first pass's progress: level 1 in 0..0.4; its parts end at 1, or at 0.7 when level 1
+  // folds (a second pass may follow in 0.7..1).
+  auto second_pass_likely = std::make_shared<std::atomic<bool>>(false);
+  const Progress first_progress([progress, second_pass_likely](const std::string& stage, double f) {
+    const double g = f <= 0.4 ? f : 0.4 + (f - 0.4) * (second_pass_likely->load() ? 0.5 : 1.0);
+    return progress.update(stage, g);
+  });
+  PartTransferResult out =
+      level_and_parts(reference, source, landmarks, spec, first, first_progress, may_retry ? second_pass_likely.get() : nullptr);
+  if (!out.status.ok() || !may_retry || out.folds.violations() == 0) return out;
+  if (!progress.update("level 1 again with a cage on a finer grid (the result folds)", 0.7)) {
+    out.status = cancelled_status("level 1 on a finer grid");
+    return out;
+  }
+  const auto t_retry = std::chrono::steady_clock::now();
+  PartTransferOptions second = first;
+  second.transfer.cage.resolution = finer;
+  PartTransferResult alt = level_and_parts(reference, source, landmarks, spec, second, progress.sub(0.7, 1.0));
+  if (alt.status.code == StatusCode::Cancelled) return alt;
+  FoldRetry retry;
+  retry.checked = true;
+  retry.tried = true;
+  retry.resolution = finer;
+  retry.first = out.folds;
+  retry.kept = alt.status.ok() && alt.folds.violations() < out.folds.violations();
+  retry.ms = part_ms_since(t_retry);
+  if (retry.kept) out = std::move(alt);
+  out.fold_retry = retry;
   out.ms_total = part_ms_since(t_start);
   progress.update("done", 1.0);
   return out;

@@ -61,9 +61,8 @@
 // shape and its report says why. So the parts never add flips, nor self-intersections beyond
 // the bound; level 1's own folds are reported (folds_level1).
 //
-// Folds: fold_report() counts self-intersecting triangle pairs (spatial/self_intersections.h)
-// of the reference, the source and a result, and locally flipped faces of the result against
-// the source (metrics/transfer_metrics.h).
+// Folds: fold_report() (transfer/pose_transfer.h) counts self-intersecting triangle pairs of the
+// reference, the source and a result, and locally flipped faces of the result against the source.
 //
 // Status codes: those of pose_transfer for level 1; InvalidArgument for a region that selects
 // nothing, out-of-range seeds/vertices, bad radii; Cancelled. A part whose own transfer fails
@@ -153,19 +152,6 @@ struct PartTransferOptions {
   int proposal_rounds = 3;
 };
 
-struct FoldReport {
-  int self_intersections_reference = 0;  // intersecting triangle pairs of the reference
-  int self_intersections_source = 0;     // ... of the source (input)
-  int self_intersections_result = 0;     // ... of the result
-  int flipped_faces = 0;                 // result's local fold-overs against the source
-  bool new_folds() const {               // more self-intersections than the inputs together
-    return self_intersections_result > self_intersections_reference + self_intersections_source;
-  }
-};
-
-// reference: #V′ mesh; source: the input source; result: #V_source by 3 positions.
-FoldReport fold_report(const Mesh& reference, const Mesh& source, const Eigen::MatrixXd& result);
-
 struct PartReport {
   std::string name;
   int level = 2;                 // 2 = first part level
@@ -212,6 +198,11 @@ struct PartTransferResult {
   int proposal_rounds = 0;       // rounds that kept a set (PartTransferOptions::proposal_rounds)
   double landmark_error_level1 = 0, landmark_error = 0;
   double ms_level1 = 0, ms_parts = 0, ms_total = 0;
+  // PoseTransferOptions::fold_retry_resolution, applied to the whole two-level result: when the
+  // parts on the usual level-1 cage end with flipped faces or new self-intersections, level 1
+  // and its parts run again with the level-1 cage on the finer grid, and the result with fewer
+  // violations is kept (`first` = the folds of the first pass).
+  FoldRetry fold_retry;
 };
 
 // The vertex set (ascending) a region selects on mesh (V, F). InvalidArgument when it selects

@@ -11,9 +11,11 @@
 
 #include "cage/mean_value_coordinates.h"
 #include "common/threads.h"
+#include "metrics/transfer_metrics.h"
 #include "mesh/validate.h"
 #include "operators/operators.h"
 #include "spectral/spectral_basis.h"
+#include "spatial/self_intersections.h"
 
 namespace mm {
 
@@ -65,6 +67,15 @@ Status normalize(const Mesh& m, const char* which, Normalized* out) {
 }
 
 }  // namespace transfer_detail
+
+FoldReport fold_report(const Mesh& reference, const Mesh& source, const Eigen::MatrixXd& result) {
+  FoldReport r;
+  r.self_intersections_reference = self_intersections(reference.V, reference.F).pairs;
+  r.self_intersections_source = self_intersections(source.V, source.F).pairs;
+  r.self_intersections_result = self_intersections(result, source.F).pairs;
+  r.flipped_faces = transfer_metrics(result, source.V, source.F).flipped_faces;
+  return r;
+}
 
 PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, const std::vector<LandmarkPair>& landmarks,
                                  const PoseTransferOptions& opt, const Progress& progress, const Mesh* user_cage) {
@@ -128,7 +139,8 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
     Eigen::MatrixXi CF;
     double ms_cage = 0, ms_mvc = 0;
   };
-  auto cage_stage = [&source, &src, &opt, user_cage](const Progress& cage_progress, const Progress& mvc_progress) {
+  auto cage_stage = [&source, &src, &opt, user_cage](const EnclosingCageOptions& cage_options, const Progress& cage_progress,
+                                                     const Progress& mvc_progress) {
     CageStage r;
     auto t = clock::now();
     if (user_cage) {
@@ -137,7 +149,7 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
       r.status = check_user_cage(source.V, r.C, &r.CF, opt.cage.min_clearance * 1e-3);
       if (!r.status.ok()) return r;
     } else {
-      EnclosingCage cage = enclosing_cage(source.V, source.F, opt.cage, cage_progress);
+      EnclosingCage cage = enclosing_cage(source.V, source.F, cage_options, cage_progress);
       if (!cage.status.ok()) {
         r.status = cage.status;
         return r;
@@ -181,7 +193,9 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
       report.recorded = true;
       return !stop_cage.load();
     });
-    cage_task = Task([&cage_result, cage_stage, watch] { cage_result = cage_stage(watch.sub(0.0, 0.45), watch.sub(0.45, 1.0)); });
+    cage_task = Task([&cage_result, cage_stage, watch, &opt] {
+      cage_result = cage_stage(opt.cage, watch.sub(0.0, 0.45), watch.sub(0.45, 1.0));
+    });
   }
 #endif
   // Whatever returns early below stops the cage task first (the task's destructor then waits).
@@ -275,7 +289,7 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
       }
     }
     CageStage cs = cage_threaded ? std::move(cage_result)
-                                 : cage_stage(progress.sub(0.4, 0.6), progress.sub(0.6, 0.85));
+                                 : cage_stage(opt.cage, progress.sub(0.4, 0.6), progress.sub(0.6, 0.85));
     if (!cs.status.ok()) {
       out.status = cs.status;
       return out;
@@ -284,55 +298,104 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
       out.status = cancelled_status("mean-value coordinates");
       return out;
     }
-    out.cage_rest = cs.C;
-    out.cage_faces = cs.CF;
-    out.ms.cage = cs.ms_cage;
-    out.ms.mvc = cs.ms_mvc;
-    const Eigen::MatrixXd& Cn = cs.Cn;
-    const Eigen::MatrixXi& CF = cs.CF;
-
-    // 6. Optimisation (Eq. 12, App. B).
-    t0 = clock::now();
-    CagePoseProblem prob;
-    prob.C = Cn;
-    prob.CF = CF;
-    prob.P = PhiK_src.transpose() * src.mass.asDiagonal() * cs.Psi;  // Eq. 8: Φ̂_Kᵀ A Ψ
-    prob.T = alpha_ref;
-    if (opt.fixed_cage_weight > 0) {
-      // The lightest cage vertices held, in normalized coordinates (where the optimisation runs).
-      const Eigen::VectorXd w = cs.Psi.cwiseAbs().transpose() * src.mass;
-      std::vector<int> order(static_cast<size_t>(w.size()));
-      std::iota(order.begin(), order.end(), 0);
-      std::stable_sort(order.begin(), order.end(), [&w](int x, int y) { return w[x] < w[y]; });
-      const double budget = opt.fixed_cage_weight * w.sum();
-      double held = 0;
-      for (int c : order) {
-        if ((held += w[c]) > budget) break;
-        prob.fixed.push_back(c);
-      }
-      std::sort(prob.fixed.begin(), prob.fixed.end());
-      prob.fixed_positions.resize(static_cast<Eigen::Index>(prob.fixed.size()), 3);
-      for (size_t f = 0; f < prob.fixed.size(); ++f) prob.fixed_positions.row(static_cast<Eigen::Index>(f)) = Cn.row(prob.fixed[f]);
-      out.fixed_cage_vertices = static_cast<int>(prob.fixed.size());
-    }
-    const CagePoseResult sol = solve_cage_pose(prob, opt.solver, progress.sub(0.85, 1.0));
-    if (!sol.status.ok()) {
-      out.status = sol.status;
-      return out;
-    }
-    out.iterations = sol.iterations;
-    out.converged = sol.converged;
-    out.energy = sol.energy;
-    out.energy_lf = sol.energy_lf;
-    out.energy_lc = sol.energy_lc;
-    out.energy_sf = sol.energy_sf;
-    Vn = cs.Psi * sol.C;
+    // 6. Optimisation (Eq. 12, App. B) in the cage of `stage`; fills o's cage, solver and
+    // position fields.
     const Eigen::RowVector3d place = opt.placement == TransferPlacement::Reference ? ref.centroid : src.centroid;
-    out.cage_deformed = (src.scale * sol.C).rowwise() + place;
-    out.ms.optimisation = elapsed_ms(t0);
+    auto optimise = [&](const CageStage& stage, const Progress& p, PoseTransferResult* o) -> Status {
+      const auto t = clock::now();
+      o->cage_rest = stage.C;
+      o->cage_faces = stage.CF;
+      o->ms.cage = stage.ms_cage;
+      o->ms.mvc = stage.ms_mvc;
+      CagePoseProblem prob;
+      prob.C = stage.Cn;
+      prob.CF = stage.CF;
+      prob.P = PhiK_src.transpose() * src.mass.asDiagonal() * stage.Psi;  // Eq. 8: Φ̂_Kᵀ A Ψ
+      prob.T = alpha_ref;
+      o->fixed_cage_vertices = 0;
+      if (opt.fixed_cage_weight > 0) {
+        // The lightest cage vertices held, in normalized coordinates (where the optimisation runs).
+        const Eigen::VectorXd w = stage.Psi.cwiseAbs().transpose() * src.mass;
+        std::vector<int> order(static_cast<size_t>(w.size()));
+        std::iota(order.begin(), order.end(), 0);
+        std::stable_sort(order.begin(), order.end(), [&w](int x, int y) { return w[x] < w[y]; });
+        const double budget = opt.fixed_cage_weight * w.sum();
+        double held = 0;
+        for (int c : order) {
+          if ((held += w[c]) > budget) break;
+          prob.fixed.push_back(c);
+        }
+        std::sort(prob.fixed.begin(), prob.fixed.end());
+        prob.fixed_positions.resize(static_cast<Eigen::Index>(prob.fixed.size()), 3);
+        for (size_t f = 0; f < prob.fixed.size(); ++f)
+          prob.fixed_positions.row(static_cast<Eigen::Index>(f)) = stage.Cn.row(prob.fixed[f]);
+        o->fixed_cage_vertices = static_cast<int>(prob.fixed.size());
+      }
+      const CagePoseResult sol = solve_cage_pose(prob, opt.solver, p);
+      if (!sol.status.ok()) return sol.status;
+      o->iterations = sol.iterations;
+      o->converged = sol.converged;
+      o->energy = sol.energy;
+      o->energy_lf = sol.energy_lf;
+      o->energy_lc = sol.energy_lc;
+      o->energy_sf = sol.energy_sf;
+      o->V = (src.scale * (stage.Psi * sol.C)).rowwise() + place;
+      o->cage_deformed = (src.scale * sol.C).rowwise() + place;
+      o->ms.optimisation = elapsed_ms(t);
+      if (!o->V.allFinite()) return Status::error(StatusCode::NumericalError, "pose transfer produced non-finite positions");
+      return Status{};
+    };
+    const bool check_folds = !user_cage && opt.fold_retry_resolution > opt.cage.resolution;
+    if (!(out.status = optimise(cs, progress.sub(0.85, check_folds ? 0.9 : 1.0), &out)).ok()) return out;
+    if (check_folds) {
+      // No folds at the whole-body step (PoseTransferOptions::fold_retry_resolution).
+      out.fold_retry.checked = true;
+      out.folds = fold_report(reference, source, out.V);
+      if (out.folds.violations() > 0) {
+        if (!progress.update("cage on a finer grid (the result folds)", 0.9)) {
+          out.status = cancelled_status("cage on a finer grid");
+          return out;
+        }
+        const auto t_retry = clock::now();
+        out.fold_retry.tried = true;
+        out.fold_retry.resolution = opt.fold_retry_resolution;
+        out.fold_retry.first = out.folds;
+        EnclosingCageOptions finer = opt.cage;
+        finer.resolution = opt.fold_retry_resolution;
+        const CageStage cs2 = cage_stage(finer, progress.sub(0.9, 0.95), progress.sub(0.95, 0.97));
+        PoseTransferResult alt;
+        Status s = cs2.status;
+        if (s.ok()) s = optimise(cs2, progress.sub(0.97, 1.0), &alt);
+        if (s.code == StatusCode::Cancelled) {
+          out.status = s;
+          return out;
+        }
+        if (s.ok()) {
+          alt.folds = fold_report(reference, source, alt.V);
+          if (alt.folds.violations() < out.folds.violations()) {
+            out.fold_retry.kept = true;
+            out.cage_rest = std::move(alt.cage_rest);
+            out.cage_faces = std::move(alt.cage_faces);
+            out.cage_deformed = std::move(alt.cage_deformed);
+            out.fixed_cage_vertices = alt.fixed_cage_vertices;
+            out.iterations = alt.iterations;
+            out.converged = alt.converged;
+            out.energy = std::move(alt.energy);
+            out.energy_lf = alt.energy_lf;
+            out.energy_lc = alt.energy_lc;
+            out.energy_sf = alt.energy_sf;
+            out.V = std::move(alt.V);
+            out.folds = alt.folds;
+          }
+        }
+        out.fold_retry.ms = elapsed_ms(t_retry);
+      }
+    }
   }
-  const Eigen::RowVector3d place = opt.placement == TransferPlacement::Reference ? ref.centroid : src.centroid;
-  out.V = (src.scale * Vn).rowwise() + place;
+  if (opt.method != TransferMethod::Yin) {
+    const Eigen::RowVector3d place = opt.placement == TransferPlacement::Reference ? ref.centroid : src.centroid;
+    out.V = (src.scale * Vn).rowwise() + place;
+  }
   if (!out.V.allFinite()) {
     out.status = Status::error(StatusCode::NumericalError, "pose transfer produced non-finite positions");
     return out;

@@ -29,6 +29,7 @@
 // every stage needs only triangles with positive area.
 #pragma once
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -82,6 +83,47 @@ struct PoseTransferOptions {
   // the lightest vertices whose weights add up to at most this fraction of the total are held.
   // 0: every cage vertex is free.
   double fixed_cage_weight = 0;
+  // No folds at the whole-body step (issue 16): when the result in the automatic cage flips faces
+  // against the source, or has more self-intersecting triangle pairs than the reference and the
+  // source together, the cage is built again on this finer offset grid (cells along the longest
+  // side) and the optimisation runs again; the result with fewer violations (flipped faces plus
+  // self-intersecting pairs beyond that bound) is kept. The cause (docs/transfer.md, "Folds at
+  // level 1"): on the 80-cell grid, decimation to 450 vertices bridges the gap between a pair of
+  // legs, the legs then share cage vertices, and the optimisation pulls the feet into each other
+  // (horse0 → camel_ref: 366 pairs against 293 allowed). 0 (or ≤ cage.resolution): no check —
+  // the part transfers' own calls, which the part gate checks instead.
+  int fold_retry_resolution = 128;
+};
+
+// Folds of a transfer result (issue 16): self-intersecting triangle pairs (spatial/
+// self_intersections.h) of the reference, the source and the result, and locally flipped faces
+// of the result against the source (metrics/transfer_metrics.h).
+struct FoldReport {
+  int self_intersections_reference = 0;  // intersecting triangle pairs of the reference
+  int self_intersections_source = 0;     // ... of the source (input)
+  int self_intersections_result = 0;     // ... of the result
+  int flipped_faces = 0;                 // result's local fold-overs against the source
+  bool new_folds() const {               // more self-intersections than the inputs together
+    return self_intersections_result > self_intersections_reference + self_intersections_source;
+  }
+  // Flipped faces plus the self-intersecting pairs beyond the inputs' count (0 = no fold).
+  int violations() const {
+    return flipped_faces +
+           std::max(0, self_intersections_result - self_intersections_reference - self_intersections_source);
+  }
+};
+
+// reference: #V′ mesh; source: the input source; result: #V_source by 3 positions.
+FoldReport fold_report(const Mesh& reference, const Mesh& source, const Eigen::MatrixXd& result);
+
+// What PoseTransferOptions::fold_retry_resolution did.
+struct FoldRetry {
+  bool checked = false;  // the result's folds were counted (PoseTransferResult::folds is valid)
+  bool tried = false;    // the first result folded: the cage was built again on the finer grid
+  bool kept = false;     // ... and that result had fewer violations, so it is the one returned
+  int resolution = 0;    // the finer grid's cells along the longest side
+  FoldReport first;      // the folds of the first result (valid when tried)
+  double ms = 0;         // time of the second cage, coordinates and optimisation
 };
 
 struct PoseTransferTimings {     // wall-clock milliseconds per stage (informational)
@@ -106,6 +148,8 @@ struct PoseTransferResult {
   bool converged = true;           // cage solve reached its tolerance (Yin only)
   std::vector<double> energy;      // Eq. 12 energy after each iteration (Yin only)
   double energy_lf = 0, energy_lc = 0, energy_sf = 0; // final unweighted terms (Yin only)
+  FoldReport folds;                // the result's folds, when fold_retry.checked
+  FoldRetry fold_retry;            // Yin with the automatic cage and fold_retry_resolution set
   PoseTransferTimings ms;
 };
 

@@ -602,6 +602,10 @@ export const panel = {
       if (toReference) rows.push(['to reference', `mean ${fixed(toReference.vertexErrorMean)} × diagonal (same connectivity: the reference's pose itself)`]);
       rows.push(['solve', `${options.method}: ${options.method === 'yin' ? `${info.iterations} cage iterations${info.converged ? '' : ' (cap reached)'}, ` : ''}${info.couplingIterations} coupling steps, ${fixed(info.ms.total / 1000)} s`]);
       const parts = transfer.result.parts?.info;
+      const retry = parts ? parts.foldRetry : info.foldRetry;
+      if (retry?.tried) {
+        rows.push(['folds', `the first result had ${retry.firstFlips} flipped faces and ${retry.firstSelfIntersections} self-intersecting triangle pairs (the inputs ${retry.inputSelfIntersections}): ${parts ? 'level 1 and its parts ran again' : 'the cage was built again'} on a ${retry.resolution}-cell grid, ${retry.kept ? 'kept' : 'not kept (no fewer folds)'} (${fixed(retry.ms / 1000)} s)`]);
+      }
       if (parts) {
         const kept = keptParts(parts.parts).length;
         rows.push(['parts', `${kept} of ${parts.parts.length} kept (level 1 ${fixed(parts.ms.level1 / 1000)} s, parts ${fixed(parts.ms.parts / 1000)} s)`]);

@@ -8,7 +8,9 @@
 //   placement); a missing one is the core's default, an unknown one an InvalidArgument error};
 //   buffers {cagePositions?, cageIndices?}: the user's closed cage around the source (default automatic)
 //   → buffers {positions: Float32Array (welded #V·3 of the source), cagePositions, cageIndices}
-//     info {gammaDominance, iterations, converged, couplingIterations, ms, k, gamma: number[]}
+//     info {gammaDominance, iterations, converged, couplingIterations, ms, k, gamma: number[],
+//       foldRetry {tried, kept, resolution, firstFlips, firstSelfIntersections,
+//       inputSelfIntersections, ms} (the first result folded: the cage was built on a finer grid)}
 //   Progress messages carry the core's stages (eigenbasis, coupled bases, cage: …,
 //   mean-value coordinates, optimisation); returning false from ctx.progress cancels.
 // partTransfer: hierarchical part transfer (paper 000 Sec. 4.3): the whole-body transfer, then
@@ -26,7 +28,8 @@
 //     fixedCageVertices (its transfer ran in the level-1 cage, this many cage vertices held),
 //     seamDihedralMean,
 //     seamDihedralMax, ms}] (transfer order, depth first), folds {reference, source, level1,
-//     result, flipsLevel1, flips}, ms {level1, parts, total}}
+//     result, flipsLevel1, flips}, foldRetry (as transfer's, for the whole two-level run),
+//     ms {level1, parts, total}}
 // compare: options {slotA = 'main', slotB = 'reference'} (same vertex order); buffers
 //   {positionsA?: welded #V·3} compares those positions (e.g. a transfer result) instead of slotA's
 //   → info {vertexErrorMean, vertexErrorMax, laplacianChange, edgeDistortionMean,
@@ -57,6 +60,7 @@ function poseInfo(r) {
   return {
     gammaDominance: r.gammaDominance, iterations: r.iterations, converged: r.converged,
     couplingIterations: r.couplingIterations, ms: r.ms, k: r.k, gamma: Array.from(r.gamma),
+    foldRetry: r.foldRetry,
   };
 }
 
@@ -97,6 +101,7 @@ export const ops = {
         proposals: { tried: r.proposalsTried, kept: r.proposalKept, rounds: r.proposalRounds, landmarkErrorLevel1: r.landmarkErrorLevel1, landmarkError: r.landmarkError },
         parts: r.parts.map(({ sourceVertices, ...p }) => p),
         folds: r.folds,
+        foldRetry: r.foldRetry,
         ms: r.ms,
       },
     };
