@@ -604,7 +604,7 @@ export const panel = {
       const parts = transfer.result.parts?.info;
       const retry = parts ? parts.foldRetry : info.foldRetry;
       if (retry?.tried) {
-        rows.push(['folds', `the first result had ${retry.firstFlips} flipped faces and ${retry.firstSelfIntersections} self-intersecting triangle pairs (the inputs ${retry.inputSelfIntersections}): ${parts ? 'level 1 and its parts ran again' : 'the cage was built again'} on a ${retry.resolution}-cell grid, ${retry.kept ? 'kept' : 'not kept (no fewer folds)'} (${fixed(retry.ms / 1000)} s)`]);
+        rows.push(['folds', `the first result had ${retry.firstFlips} flipped face${retry.firstFlips === 1 ? '' : 's'} and ${retry.firstSelfIntersections} self-intersecting triangle pairs (the inputs ${retry.inputSelfIntersections}): ${parts ? 'level 1 and its parts ran again' : 'the cage was built again'} on a ${retry.resolution}-cell grid, ${retry.kept ? 'kept' : 'not kept (no fewer folds)'} (${fixed(retry.ms / 1000)} s)`]);
       }
       if (parts) {
         const kept = keptParts(parts.parts).length;
