@@ -355,6 +355,14 @@ TEST(PartTransferDifferent, CatToLionHorseToCamelMichaelToArmadillo) {
       std::printf("[ parts ] %s not in this checkout (../shared/data): skipped\n", c.ref);
       continue;
     }
+#ifdef __EMSCRIPTEN__
+    // michael9 (52,565 vertices, ../shared) runs natively only: with the fold retry's second pass
+    // (20 of 41 flips left) it took ~60 s of the wasm suite's part process on this machine.
+    if (std::string(c.ref).rfind("../", 0) == 0) {
+      std::printf("[ parts ] %s: held-out meshes run natively only\n", c.ref);
+      continue;
+    }
+#endif
     const Mesh R = test::load_mesh(c.ref), S = test::load_mesh(c.src);
     const auto pairs = part_transfer_test::load_pairs(c.lm);
     const PartTransferResult r = part_transfer(R, S, pairs, nullptr);
