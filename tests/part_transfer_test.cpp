@@ -30,6 +30,16 @@ std::vector<LandmarkPair> load_pairs(const std::string& rel) {
   return out;
 }
 
+// Aligned error of the landmark pairs' source vertices in V against their reference vertices.
+double landmark_error(const Eigen::MatrixXd& V, const Eigen::MatrixXd& reference, const std::vector<LandmarkPair>& pairs) {
+  Eigen::MatrixXd L(pairs.size(), 3), LR(pairs.size(), 3);
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    L.row(k) = V.row(pairs[k].source);
+    LR.row(k) = reference.row(pairs[k].reference);
+  }
+  return aligned_vertex_error(L, LR);
+}
+
 void print_reports(const char* what, const PartTransferResult& r) {
   for (const PartReport& p : r.reports)
     std::printf("[ parts ] %s: level %d %-48s %s | %d/%d v, sub %d, lm %d, seam %d v, %srot %.1f°, seam Δdihedral mean %.2f° max %.1f° (before %.2f° / %.1f°), %.0f ms (eigen %.0f, coupling %.0f, cage %.0f, mvc %.0f, optim %.0f, glue %.0f)\n",
@@ -328,13 +338,8 @@ TEST(TransferFolds, HorseToCamelCageOnAFinerGrid) {
   EXPECT_EQ(fb.flipped_faces, 0);
   EXPECT_EQ(b.cage_rest.rows(), a.cage_rest.rows());  // the same cage size, on the finer grid
   // The landmarks land about as close (measured 0.0501 → 0.0515 of the diagonal, aligned).
-  Eigen::MatrixXd La(pairs.size(), 3), Lb(pairs.size(), 3), LR(pairs.size(), 3);
-  for (size_t k = 0; k < pairs.size(); ++k) {
-    La.row(k) = a.V.row(pairs[k].source);
-    Lb.row(k) = b.V.row(pairs[k].source);
-    LR.row(k) = R.V.row(pairs[k].reference);
-  }
-  const double ea = aligned_vertex_error(La, LR), eb = aligned_vertex_error(Lb, LR);
+  const double ea = part_transfer_test::landmark_error(a.V, R.V, pairs),
+               eb = part_transfer_test::landmark_error(b.V, R.V, pairs);
   std::printf("[ folds ] horse0 -> camel_ref: self-intersections %d -> %d (inputs %d), landmark error %.4f -> %.4f, retry %.0f ms\n",
               fa.self_intersections_result, fb.self_intersections_result,
               fa.self_intersections_reference + fa.self_intersections_source, ea, eb, b.fold_retry.ms);
@@ -368,13 +373,8 @@ TEST(PartTransferDifferent, CatToLionHorseToCamelMichaelToArmadillo) {
     const PartTransferResult r = part_transfer(R, S, pairs, nullptr);
     ASSERT_TRUE(r.status.ok()) << r.status.message;
     const TransferMetrics m1 = transfer_metrics(r.V_level1, S.V, S.F), m2 = transfer_metrics(r.V, S.V, S.F);
-    Eigen::MatrixXd L1(pairs.size(), 3), L2(pairs.size(), 3), LR(pairs.size(), 3);
-    for (size_t k = 0; k < pairs.size(); ++k) {
-      L1.row(k) = r.V_level1.row(pairs[k].source);
-      L2.row(k) = r.V.row(pairs[k].source);
-      LR.row(k) = R.V.row(pairs[k].reference);
-    }
-    const double l1 = aligned_vertex_error(L1, LR), l2 = aligned_vertex_error(L2, LR);
+    const double l1 = part_transfer_test::landmark_error(r.V_level1, R.V, pairs),
+                 l2 = part_transfer_test::landmark_error(r.V, R.V, pairs);
     double g1 = -1, g2 = -1;
     if (c.gt) {
       const Mesh G = test::load_mesh(c.gt);
