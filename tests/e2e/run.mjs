@@ -1178,7 +1178,7 @@ const maxDistance = (a, b) => {
   return m;
 };
 
-it('transfer parts: automatic parts on the crouching cat — proposed, transferred again and glued, coloured, saved and run again from the file; the CLI agrees', async ({ page, pageErrors }) => {
+it('transfer parts: automatic parts on the crouching cat — proposed, transferred again and glued, coloured, saved and run again from the file; the CLI agrees', async ({ page, pageErrors, browser }) => {
   const errorsBefore = pageErrors.length;
   const referenceFile = path.join(repoDir, 'data/pose/cat-01.ply');
   const sourceFile = path.join(repoDir, 'data/pose/cat-reference.ply');
@@ -1269,26 +1269,30 @@ it('transfer parts: automatic parts on the crouching cat — proposed, transferr
   check(proposals && proposals.tried >= 1 && proposals.kept < proposals.tried && proposals.landmarkError <= proposals.landmarkErrorLevel1,
     `proposal sets: ${JSON.stringify(proposals)}`);
   check(proposals.tried < 2 || await page.isVisible('#tr-parts-proposals'), 'the proposal sets tried are not shown');
-  const run = spawnSync(cliPath, ['transfer', '--reference', referenceFile, '--source', sourceFile, '--parts', pageParts, '--out', cliOut, '--parts-out', cliParts], { encoding: 'utf8', timeout: 120000 });
-  check(run.status === 0, `meshmorph transfer --parts (the page's) failed (${run.status}): ${run.stderr}`);
-  const cli = readPlyVertices(fs.readFileSync(cliOut));
-  const cliDifference = maxDistance(cli, result) / diagonal;
-  const cliKept = (run.stdout.match(/(\d+) kept/) || [])[1];
-  // Which parts each kept, in transfer order (the CLI prints one line per part, "skipped: ..." on
-  // the ones it did not keep).
-  const cliVerdicts = run.stdout.split('\n').filter((l) => /^ {4}level \d/.test(l)).map((l) => !/skipped:/.test(l));
-  const pageVerdicts = parts.map((p) => p.ok && !p.rejected);
-  const sameParts = cliVerdicts.length === pageVerdicts.length && cliVerdicts.every((k, i) => k === pageVerdicts[i]);
-  const cliError = centredMeanDistance(cli, reference) / diagonal;
-  console.log(`     proposal sets: ${proposals.tried} tried in ${proposals.rounds} round(s), set ${proposals.kept + 1} kept; page vs CLI (the page's parts): max vertex difference ${cliDifference.toExponential(2)}·diag; CLI kept ${cliKept} of ${JSON.parse(fs.readFileSync(cliParts, 'utf8')).parts.length}, the page ${kept.length} (${sameParts ? 'the same parts' : `not the same parts: CLI ${cliVerdicts.map(Number).join('')}, page ${pageVerdicts.map(Number).join('')}`}); mean distance to the reference: page ${e2.toFixed(4)}, CLI ${cliError.toFixed(4)} (level 1 ${e1.toFixed(4)})`);
-  // The builds' part transfers differ in their last bits (the eigensolver's, amplified on limbs),
-  // and with three rounds of parts a part near the gate's thresholds can be kept by one build and
-  // rejected by the other (docs/transfer.md: cat-01 measured 6 against 7 of 8 kept, 0.11·diag
-  // apart at that part; and 7 of 10 each, but not the same 7, 5.7e-2·diag apart). So: where both
-  // keep the same parts, the meshes agree to 2e-2·diag; either way the CLI's result on the page's
-  // parts is closer to the reference than level 1, by a gain within half of the page's.
-  if (sameParts) check(cliDifference < 2e-2, `page and CLI keep the same parts and differ by ${cliDifference}·diag`);
-  check(cliError < e1 && Math.abs(cliError - e2) <= 0.5 * (e1 - e2), `the CLI on the page's parts: mean distance ${cliError} against the page's ${e2} (level 1 ${e1})`);
+  // The CLI on the page's parts (Chromium only: Firefox runs the same wasm op, and its page
+  // result is compared with Chromium's numbers in the log — CI time, twenty-second session).
+  if (browser !== 'firefox') {
+    const run = spawnSync(cliPath, ['transfer', '--reference', referenceFile, '--source', sourceFile, '--parts', pageParts, '--out', cliOut, '--parts-out', cliParts], { encoding: 'utf8', timeout: 120000 });
+    check(run.status === 0, `meshmorph transfer --parts (the page's) failed (${run.status}): ${run.stderr}`);
+    const cli = readPlyVertices(fs.readFileSync(cliOut));
+    const cliDifference = maxDistance(cli, result) / diagonal;
+    const cliKept = (run.stdout.match(/(\d+) kept/) || [])[1];
+    // Which parts each kept, in transfer order (the CLI prints one line per part, "skipped: ..." on
+    // the ones it did not keep).
+    const cliVerdicts = run.stdout.split('\n').filter((l) => /^ {4}level \d/.test(l)).map((l) => !/skipped:/.test(l));
+    const pageVerdicts = parts.map((p) => p.ok && !p.rejected);
+    const sameParts = cliVerdicts.length === pageVerdicts.length && cliVerdicts.every((k, i) => k === pageVerdicts[i]);
+    const cliError = centredMeanDistance(cli, reference) / diagonal;
+    console.log(`     proposal sets: ${proposals.tried} tried in ${proposals.rounds} round(s), set ${proposals.kept + 1} kept; page vs CLI (the page's parts): max vertex difference ${cliDifference.toExponential(2)}·diag; CLI kept ${cliKept} of ${JSON.parse(fs.readFileSync(cliParts, 'utf8')).parts.length}, the page ${kept.length} (${sameParts ? 'the same parts' : `not the same parts: CLI ${cliVerdicts.map(Number).join('')}, page ${pageVerdicts.map(Number).join('')}`}); mean distance to the reference: page ${e2.toFixed(4)}, CLI ${cliError.toFixed(4)} (level 1 ${e1.toFixed(4)})`);
+    // The builds' part transfers differ in their last bits (the eigensolver's, amplified on limbs),
+    // and with three rounds of parts a part near the gate's thresholds can be kept by one build and
+    // rejected by the other (docs/transfer.md: cat-01 measured 6 against 7 of 8 kept, 0.11·diag
+    // apart at that part; and 7 of 10 each, but not the same 7, 5.7e-2·diag apart). So: where both
+    // keep the same parts, the meshes agree to 2e-2·diag; either way the CLI's result on the page's
+    // parts is closer to the reference than level 1, by a gain within half of the page's.
+    if (sameParts) check(cliDifference < 2e-2, `page and CLI keep the same parts and differ by ${cliDifference}·diag`);
+    check(cliError < e1 && Math.abs(cliError - e2) <= 0.5 * (e1 - e2), `the CLI on the page's parts: mean distance ${cliError} against the page's ${e2} (level 1 ${e1})`);
+  }
 
   // Save parts → load the file → Parts: from file → the same mesh.
   const [saved] = await Promise.all([page.waitForEvent('download', { timeout: 30000 }), page.click('#tr-parts-save')]);
