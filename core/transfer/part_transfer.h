@@ -200,8 +200,9 @@ struct PartTransferResult {
   double ms_level1 = 0, ms_parts = 0, ms_total = 0;
   // PoseTransferOptions::fold_retry_resolution, applied to the whole two-level result: when the
   // parts on the usual level-1 cage end with flipped faces or new self-intersections, level 1
-  // and its parts run again with the level-1 cage on the finer grid, and the result with fewer
-  // violations is kept (`first` = the folds of the first pass).
+  // runs again with its cage on the finer grid — and its parts, if that level 1 folds less than
+  // the first — and the result with fewer violations is kept (`first` = the folds of the first
+  // pass).
   FoldRetry fold_retry;
 };
 
