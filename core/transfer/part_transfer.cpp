@@ -800,7 +800,7 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     si_current = si_kept, flips_current = flips_kept;
   }
   out.ms_parts = part_ms_since(t_parts);
-  out.folds = fold_report(reference, source, out.V);
+  out.folds = fold_report(out.folds_level1, source, out.V);  // the inputs' counts from level 1
   out.ms_total = part_ms_since(t_start);
   progress.update("done", 1.0);
   return out;
@@ -821,13 +821,13 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
   first.transfer.fold_retry_resolution = 0;
   // The first pass's progress: level 1 in 0..0.4; its parts end at 1, or at 0.7 when level 1
   // folds (a second pass may follow in 0.7..1).
-  auto second_pass_likely = std::make_shared<std::atomic<bool>>(false);
-  const Progress first_progress([progress, second_pass_likely](const std::string& stage, double f) {
-    const double g = f <= 0.4 ? f : 0.4 + (f - 0.4) * (second_pass_likely->load() ? 0.5 : 1.0);
+  std::atomic<bool> second_pass_likely{false};
+  const Progress first_progress([&progress, &second_pass_likely](const std::string& stage, double f) {
+    const double g = f <= 0.4 ? f : 0.4 + (f - 0.4) * (second_pass_likely.load() ? 0.5 : 1.0);
     return progress.update(stage, g);
   });
   PartTransferResult out =
-      level_and_parts(reference, source, landmarks, spec, first, first_progress, may_retry ? second_pass_likely.get() : nullptr);
+      level_and_parts(reference, source, landmarks, spec, first, first_progress, may_retry ? &second_pass_likely : nullptr);
   if (!out.status.ok() || !may_retry || out.folds.violations() == 0) return out;
   if (!progress.update("level 1 again with a cage on a finer grid (the result folds)", 0.7)) {
     out.status = cancelled_status("level 1 on a finer grid");

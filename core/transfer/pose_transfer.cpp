@@ -68,13 +68,18 @@ Status normalize(const Mesh& m, const char* which, Normalized* out) {
 
 }  // namespace transfer_detail
 
-FoldReport fold_report(const Mesh& reference, const Mesh& source, const Eigen::MatrixXd& result) {
-  FoldReport r;
-  r.self_intersections_reference = self_intersections(reference.V, reference.F).pairs;
-  r.self_intersections_source = self_intersections(source.V, source.F).pairs;
+FoldReport fold_report(const FoldReport& inputs, const Mesh& source, const Eigen::MatrixXd& result) {
+  FoldReport r = inputs;
   r.self_intersections_result = self_intersections(result, source.F).pairs;
   r.flipped_faces = transfer_metrics(result, source.V, source.F).flipped_faces;
   return r;
+}
+
+FoldReport fold_report(const Mesh& reference, const Mesh& source, const Eigen::MatrixXd& result) {
+  FoldReport inputs;
+  inputs.self_intersections_reference = self_intersections(reference.V, reference.F).pairs;
+  inputs.self_intersections_source = self_intersections(source.V, source.F).pairs;
+  return fold_report(inputs, source, result);
 }
 
 PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, const std::vector<LandmarkPair>& landmarks,
@@ -371,7 +376,7 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
           return out;
         }
         if (s.ok()) {
-          alt.folds = fold_report(reference, source, alt.V);
+          alt.folds = fold_report(out.folds, source, alt.V);
           if (alt.folds.violations() < out.folds.violations()) {
             out.fold_retry.kept = true;
             out.cage_rest = std::move(alt.cage_rest);

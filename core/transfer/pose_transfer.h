@@ -115,6 +115,8 @@ struct FoldReport {
 
 // reference: #V′ mesh; source: the input source; result: #V_source by 3 positions.
 FoldReport fold_report(const Mesh& reference, const Mesh& source, const Eigen::MatrixXd& result);
+// The same for another result of the same inputs: their counts are taken from `inputs`.
+FoldReport fold_report(const FoldReport& inputs, const Mesh& source, const Eigen::MatrixXd& result);
 
 // What PoseTransferOptions::fold_retry_resolution did.
 struct FoldRetry {
