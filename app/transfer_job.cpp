@@ -33,6 +33,8 @@ const OptionSchema<PoseTransferOptions>& transfer_options() {
               "offset grid cells along the longest side for the automatic cage");
     s.integer("fold_retry_resolution", [](O& o) -> int& { return o.fold_retry_resolution; }, 0, 1024,
               "when the result flips faces or self-intersects more than the inputs together, build the automatic cage again on this finer grid and keep the result with fewer folds (0: off)");
+    s.integer("flip_repair_rings", [](O& o) -> int& { return o.flip_repair_rings; }, 0, 64,
+              "when the result still flips faces, relax them and this many rings of vertices around them as rigidly as possible towards the source's shape, everything else held (0: off)");
     s.integer("max_iterations", [](O& o) -> int& { return o.solver.max_iterations; }, 1, 10000,
               "re-linearizations of the cage solve");
     s.number("tolerance", [](O& o) -> double& { return o.solver.tolerance; }, 0, 1,
@@ -193,6 +195,14 @@ std::string transfer_summary(const TransferJobResult& r, const PoseTransferOptio
                   r.hierarchical ? "level 1 and parts again" : "cage rebuilt", retry.resolution, a.flipped_faces,
                   a.self_intersections_result, a.self_intersections_reference + a.self_intersections_source,
                   retry.kept ? "kept" : "not kept (no fewer folds)", retry.ms);
+    s += buf;
+  }
+  const FlipRepair& repair = r.hierarchical ? r.parts.flip_repair : t.flip_repair;
+  if (repair.tried) {
+    std::snprintf(buf, sizeof buf, "  flip repair: %d flipped faces relaxed (%s), %.0f ms\n", repair.flipped_before,
+                  repair.kept ? ("kept: " + std::to_string(repair.moved_vertices) + " vertices moved").c_str()
+                              : "not kept (no fewer folds)",
+                  repair.ms);
     s += buf;
   }
   if (r.hierarchical) {

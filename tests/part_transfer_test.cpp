@@ -323,6 +323,7 @@ TEST(TransferFolds, HorseToCamelCageOnAFinerGrid) {
   const auto pairs = part_transfer_test::load_pairs("landmarks/horse0-camel_ref.json");
   PoseTransferOptions off;
   off.fold_retry_resolution = 0;
+  off.flip_repair_rings = 0;
   const PoseTransferResult a = pose_transfer(R, S, pairs, off);
   ASSERT_TRUE(a.status.ok()) << a.status.message;
   EXPECT_FALSE(a.fold_retry.checked);

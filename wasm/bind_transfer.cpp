@@ -13,6 +13,8 @@
 //        foldRetry: {tried, kept, resolution, firstFlips, firstSelfIntersections,
 //                    inputSelfIntersections, ms} (PoseTransferOptions::fold_retry_resolution: the
 //                    first result folded, the cage was built again on the finer grid),
+//        flipRepair: {tried, kept, flippedBefore, movedVertices, ms} (flip_repair_rings: the
+//                    result still flipped faces, their neighbourhood was relaxed),
 //        ms: {eigenbases, coupling, cage, mvc, optimisation, total}}
 //   partTransfer(refPositions, refIndices, srcPositions, srcIndices, landmarks, parts, options?,
 //                partOptions?, progress?)   hierarchical part transfer (paper 000 Sec. 4.3, issue 16)
@@ -28,6 +30,7 @@
 //                triangle pairs; flipped faces against the source),
 //        foldRetry: as poseTransfer's, for the whole two-level run (level 1 and its parts again
 //                   on the finer cage grid when the first result folds),
+//        flipRepair: as poseTransfer's, on the final result,
 //        ms: {level1, parts, total}}
 //   transferMetrics(positionsA (#V·3), positionsB (#V·3), indices (#F·3))
 //     → {ok, vertexErrorMean, vertexErrorMax, laplacianChange, edgeDistortionMean,
@@ -63,6 +66,17 @@ val fold_retry_object(const FoldRetry& f) {
   return o;
 }
 
+// PoseTransferOptions::flip_repair_rings's record (pose or part transfer).
+val flip_repair_object(const FlipRepair& f) {
+  val o = val::object();
+  o.set("tried", f.tried);
+  o.set("kept", f.kept);
+  o.set("flippedBefore", f.flipped_before);
+  o.set("movedVertices", f.moved_vertices);
+  o.set("ms", f.ms);
+  return o;
+}
+
 // The level-1 fields of a pose transfer result (poseTransfer's, and partTransfer's `level1`).
 void set_pose_fields(val& out, const PoseTransferResult& r) {
   Eigen::MatrixXd g = r.gamma;
@@ -77,6 +91,7 @@ void set_pose_fields(val& out, const PoseTransferResult& r) {
   out.set("cageIndices", to_uint32_array(r.cage_faces));
   out.set("energy", to_float64_array(Eigen::Map<const Eigen::MatrixXd>(r.energy.data(), r.energy.size(), 1)));
   out.set("foldRetry", fold_retry_object(r.fold_retry));
+  out.set("flipRepair", flip_repair_object(r.flip_repair));
   val ms = val::object();
   ms.set("eigenbases", r.ms.eigenbases);
   ms.set("coupling", r.ms.coupling);
@@ -192,6 +207,7 @@ val part_transfer_js(val ref_positions, val ref_indices, val src_positions, val 
   folds.set("flips", r.folds.flipped_faces);
   out.set("folds", folds);
   out.set("foldRetry", fold_retry_object(r.fold_retry));
+  out.set("flipRepair", flip_repair_object(r.flip_repair));
   val level1 = val::object();
   set_pose_fields(level1, r.level1);
   out.set("level1", level1);

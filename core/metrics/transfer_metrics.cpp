@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <map>
+#include <set>
 #include <utility>
 #include <vector>
 
@@ -67,17 +68,16 @@ TransferMetrics transfer_metrics(const Eigen::MatrixXd& A, const Eigen::MatrixXd
   const auto adj = vertex_adjacency(F, n);
   const Eigen::VectorXd la = umbrella_magnitude(A, adj), lb = umbrella_magnitude(B, adj);
   if (lb.sum() > 0) out.laplacian_change = (la - lb).cwiseAbs().sum() / lb.sum();
-  // Edges and face neighbours (ordered map: deterministic).
-  std::map<std::pair<int, int>, std::vector<int>> edge_faces;
+  // Undirected edges (ordered set: deterministic sum).
+  std::set<std::pair<int, int>> edges;
   for (int f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k) {
       const int a = F(f, k), b = F(f, (k + 1) % 3);
-      edge_faces[{std::min(a, b), std::max(a, b)}].push_back(f);
+      edges.insert({std::min(a, b), std::max(a, b)});
     }
   double sum = 0;
   int count = 0;
-  std::vector<std::vector<int>> fn(F.rows());
-  for (const auto& [e, faces] : edge_faces) {
+  for (const auto& e : edges) {
     const double lb_e = (B.row(e.first) - B.row(e.second)).norm();
     if (lb_e > 0) {
       const double d = std::abs((A.row(e.first) - A.row(e.second)).norm() / lb_e - 1.0);
@@ -85,14 +85,34 @@ TransferMetrics transfer_metrics(const Eigen::MatrixXd& A, const Eigen::MatrixXd
       ++count;
       out.edge_distortion_max = std::max(out.edge_distortion_max, d);
     }
+  }
+  out.edge_distortion_mean = count ? sum / count : 0.0;
+  out.flipped_faces = static_cast<int>(flipped_faces(A, B, F, face_neighbours(F)).size());
+  return out;
+}
+
+std::vector<std::vector<int>> face_neighbours(const Eigen::MatrixXi& F) {
+  std::map<std::pair<int, int>, std::vector<int>> edge_faces;  // ordered: deterministic
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      edge_faces[{std::min(a, b), std::max(a, b)}].push_back(f);
+    }
+  std::vector<std::vector<int>> fn(F.rows());
+  for (const auto& [e, faces] : edge_faces)
     for (int f : faces)
       for (int g : faces)
         if (f != g) fn[f].push_back(g);
-  }
-  out.edge_distortion_mean = count ? sum / count : 0.0;
-  const Eigen::VectorXd agree_a = neighbour_agreement(A, F, fn), agree_b = neighbour_agreement(B, F, fn);
+  return fn;
+}
+
+std::vector<int> flipped_faces(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXi& F,
+                               const std::vector<std::vector<int>>& neighbours) {
+  using namespace transfer_metrics_detail;
+  const Eigen::VectorXd agree_a = neighbour_agreement(A, F, neighbours), agree_b = neighbour_agreement(B, F, neighbours);
+  std::vector<int> out;
   for (int f = 0; f < F.rows(); ++f)
-    if (agree_a[f] < 0 && agree_b[f] > 0.5) ++out.flipped_faces;
+    if (agree_a[f] < 0 && agree_b[f] > 0.5) out.push_back(f);
   return out;
 }
 

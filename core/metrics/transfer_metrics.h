@@ -13,6 +13,8 @@
 //   independent of the global rotation of a pose.
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "common/status.h"
@@ -30,6 +32,15 @@ struct TransferMetrics {
 };
 
 TransferMetrics transfer_metrics(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXi& F);
+
+// Per face, the faces sharing an edge with it (ascending edge order; non-manifold edges give
+// each of their faces all the others).
+std::vector<std::vector<int>> face_neighbours(const Eigen::MatrixXi& F);
+
+// The flipped faces of TransferMetrics (see header), ascending: A deformed, B its rest shape,
+// neighbours = face_neighbours(F).
+std::vector<int> flipped_faces(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXi& F,
+                               const std::vector<std::vector<int>>& neighbours);
 
 // Aligned vertex error: mean_i |s R a_i + t − b_i| / D (D = bbox diagonal of B) after the
 // least-squares similarity (Umeyama, linalg/rigid_fit.h) of A onto B, so that a global

@@ -580,6 +580,7 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     topt.cage.target_vertices = opt.part_cage_vertices;
     topt.cage.resolution = opt.part_cage_resolution;
     topt.fold_retry_resolution = 0;  // the part gate checks folds itself
+    topt.flip_repair_rings = 0;
     topt.placement = TransferPlacement::Reference;
     Mesh Sm{Ssub.V, Ssub.F}, Rm{Rsub.V, Rsub.F};
     // The level-1 cage where it still encloses the part (paper 000 Sec. 5), else its own.
@@ -819,6 +820,7 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
   const bool may_retry = finer > opt.transfer.cage.resolution;
   PartTransferOptions first = opt;
   first.transfer.fold_retry_resolution = 0;
+  first.transfer.flip_repair_rings = 0;  // the final result's flips are repaired below
   // The first pass's progress: level 1 in 0..0.4; its parts end at 1, or at 0.7 when level 1
   // folds (a second pass may follow in 0.7..1).
   std::atomic<bool> second_pass_likely{false};
@@ -826,9 +828,18 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
     const double g = f <= 0.4 ? f : 0.4 + (f - 0.4) * (second_pass_likely.load() ? 0.5 : 1.0);
     return progress.update(stage, g);
   });
+  // No flips (PoseTransferOptions::flip_repair_rings) on the result returned.
+  const auto finish = [&](PartTransferResult&& r) {
+    if (r.status.ok())
+      r.status = repair_transfer_flips(source, opt.transfer.flip_repair_rings, progress.sub(0.99, 1.0), &r.V, &r.folds,
+                                       &r.flip_repair);
+    r.ms_total = part_ms_since(t_start);
+    progress.update("done", 1.0);
+    return std::move(r);
+  };
   PartTransferResult out =
       level_and_parts(reference, source, landmarks, spec, first, first_progress, may_retry ? &second_pass_likely : nullptr);
-  if (!out.status.ok() || !may_retry || out.folds.violations() == 0) return out;
+  if (!out.status.ok() || !may_retry || out.folds.violations() == 0) return finish(std::move(out));
   if (!progress.update("level 1 again with a cage on a finer grid (the result folds)", 0.7)) {
     out.status = cancelled_status("level 1 on a finer grid");
     return out;
@@ -851,9 +862,7 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
   retry.ms = part_ms_since(t_retry);
   if (retry.kept) out = std::move(alt);
   out.fold_retry = retry;
-  out.ms_total = part_ms_since(t_start);
-  progress.update("done", 1.0);
-  return out;
+  return finish(std::move(out));
 }
 
 }  // namespace mm

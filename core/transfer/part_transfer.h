@@ -204,6 +204,8 @@ struct PartTransferResult {
   // the first — and the result with fewer violations is kept (`first` = the folds of the first
   // pass).
   FoldRetry fold_retry;
+  // PoseTransferOptions::flip_repair_rings, applied to the result returned (after the retry).
+  FlipRepair flip_repair;
 };
 
 // The vertex set (ascending) a region selects on mesh (V, F). InvalidArgument when it selects

@@ -1,4 +1,5 @@
 #include "transfer/pose_transfer.h"
+#include "transfer/flip_repair.h"
 
 #include <atomic>
 #include <chrono>
@@ -80,6 +81,28 @@ FoldReport fold_report(const Mesh& reference, const Mesh& source, const Eigen::M
   inputs.self_intersections_reference = self_intersections(reference.V, reference.F).pairs;
   inputs.self_intersections_source = self_intersections(source.V, source.F).pairs;
   return fold_report(inputs, source, result);
+}
+
+Status repair_transfer_flips(const Mesh& source, int rings, const Progress& progress, Eigen::MatrixXd* result,
+                             FoldReport* folds, FlipRepair* record) {
+  if (rings <= 0 || folds->flipped_faces == 0) return Status{};
+  FlipRepairOptions o;
+  o.rings = rings;
+  FlipRepairResult r = repair_flips(source, *result, o, progress);
+  record->tried = true;
+  record->flipped_before = folds->flipped_faces;
+  record->rounds = r.rounds;
+  record->ms = r.ms;
+  if (r.status.code == StatusCode::Cancelled) return r.status;
+  if (!r.status.ok() || r.flipped_after >= r.flipped_before) return Status{};
+  const FoldReport repaired = fold_report(*folds, source, r.V);
+  if (repaired.violations() < folds->violations()) {
+    record->kept = true;
+    record->moved_vertices = r.moved_vertices;
+    *result = std::move(r.V);
+    *folds = repaired;
+  }
+  return Status{};
 }
 
 PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, const std::vector<LandmarkPair>& landmarks,
@@ -350,13 +373,14 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
       if (!o->V.allFinite()) return Status::error(StatusCode::NumericalError, "pose transfer produced non-finite positions");
       return Status{};
     };
-    const bool check_folds = !user_cage && opt.fold_retry_resolution > opt.cage.resolution;
+    const bool retry_folds = opt.fold_retry_resolution > opt.cage.resolution;
+    const bool check_folds = !user_cage && (retry_folds || opt.flip_repair_rings > 0);
     if (!(out.status = optimise(cs, progress.sub(0.85, check_folds ? 0.9 : 1.0), &out)).ok()) return out;
     if (check_folds) {
       // No folds at the whole-body step (PoseTransferOptions::fold_retry_resolution).
       out.fold_retry.checked = true;
       out.folds = fold_report(reference, source, out.V);
-      if (out.folds.violations() > 0) {
+      if (retry_folds && out.folds.violations() > 0) {
         if (!progress.update("cage on a finer grid (the result folds)", 0.9)) {
           out.status = cancelled_status("cage on a finer grid");
           return out;
@@ -395,6 +419,9 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
         }
         out.fold_retry.ms = elapsed_ms(t_retry);
       }
+      if (!(out.status = repair_transfer_flips(source, opt.flip_repair_rings, progress.sub(0.99, 1.0), &out.V,
+                                               &out.folds, &out.flip_repair)).ok())
+        return out;
     }
   }
   if (opt.method != TransferMethod::Yin) {

@@ -93,6 +93,12 @@ struct PoseTransferOptions {
   // (horse0 → camel_ref: 366 pairs against 293 allowed). 0 (or ≤ cage.resolution): no check —
   // the part transfers' own calls, which the part gate checks instead.
   int fold_retry_resolution = 128;
+  // No flips: when the result (after the retry above) still flips faces against the source, the
+  // flipped faces' neighbourhood, grown by this many edge rings, is relaxed as rigidly as possible
+  // towards the source's shape with everything else held (transfer/flip_repair.h); kept when it
+  // leaves fewer violations. 0: off (the part transfers' own calls; part_transfer repairs its
+  // final result instead).
+  int flip_repair_rings = 2;
 };
 
 // Folds of a transfer result (issue 16): self-intersecting triangle pairs (spatial/
@@ -128,6 +134,21 @@ struct FoldRetry {
   double ms = 0;         // time of the second cage, coordinates and optimisation
 };
 
+// What PoseTransferOptions::flip_repair_rings did (transfer/flip_repair.h).
+struct FlipRepair {
+  bool tried = false;       // the result flipped faces: the repair ran
+  bool kept = false;        // ... and its result had fewer violations, so it is the one returned
+  int flipped_before = 0;   // flipped faces before the repair
+  int moved_vertices = 0;   // vertices the kept repair moved
+  int rounds = 0;           // regions tried
+  double ms = 0;
+};
+
+// Runs the repair on `result` when `folds` counts flipped faces (and rings > 0): replaces result
+// and folds when the repaired result has fewer violations. Cancelled status on cancel.
+Status repair_transfer_flips(const Mesh& source, int rings, const Progress& progress, Eigen::MatrixXd* result,
+                             FoldReport* folds, FlipRepair* record);
+
 struct PoseTransferTimings {     // wall-clock milliseconds per stage (informational)
   double eigenbases = 0, coupling = 0, cage = 0, mvc = 0, optimisation = 0, total = 0;
   // Natively the cage and MVC stages overlap the eigenbases and coupling (second thread), so
@@ -152,6 +173,7 @@ struct PoseTransferResult {
   double energy_lf = 0, energy_lc = 0, energy_sf = 0; // final unweighted terms (Yin only)
   FoldReport folds;                // the result's folds, when fold_retry.checked
   FoldRetry fold_retry;            // Yin with the automatic cage and fold_retry_resolution set
+  FlipRepair flip_repair;          // flip_repair_rings: what the repair did (when folds were checked)
   PoseTransferTimings ms;
 };
 

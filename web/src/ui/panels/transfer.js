@@ -606,6 +606,10 @@ export const panel = {
       if (retry?.tried) {
         rows.push(['folds', `the first result had ${retry.firstFlips} flipped face${retry.firstFlips === 1 ? '' : 's'} and ${retry.firstSelfIntersections} self-intersecting triangle pairs (the inputs ${retry.inputSelfIntersections}): ${parts ? 'level 1 and its parts ran again' : 'the cage was built again'} on a ${retry.resolution}-cell grid, ${retry.kept ? 'kept' : 'not kept (no fewer folds)'} (${fixed(retry.ms / 1000)} s)`]);
       }
+      const repair = parts ? parts.flipRepair : info.flipRepair;
+      if (repair?.tried) {
+        rows.push(['flip repair', `${repair.flippedBefore} flipped face${repair.flippedBefore === 1 ? '' : 's'} relaxed as rigidly as possible: ${repair.kept ? `kept (${repair.movedVertices} vertices moved)` : 'not kept (no fewer folds)'} (${fixed(repair.ms / 1000)} s)`]);
+      }
       if (parts) {
         const kept = keptParts(parts.parts).length;
         rows.push(['parts', `${kept} of ${parts.parts.length} kept (level 1 ${fixed(parts.ms.level1 / 1000)} s, parts ${fixed(parts.ms.parts / 1000)} s)`]);

@@ -10,7 +10,9 @@
 //   → buffers {positions: Float32Array (welded #V·3 of the source), cagePositions, cageIndices}
 //     info {gammaDominance, iterations, converged, couplingIterations, ms, k, gamma: number[],
 //       foldRetry {tried, kept, resolution, firstFlips, firstSelfIntersections,
-//       inputSelfIntersections, ms} (the first result folded: the cage was built on a finer grid)}
+//       inputSelfIntersections, ms} (the first result folded: the cage was built on a finer grid),
+//       flipRepair {tried, kept, flippedBefore, movedVertices, ms} (the result still flipped faces:
+//       their neighbourhood was relaxed as rigidly as possible)}
 //   Progress messages carry the core's stages (eigenbasis, coupled bases, cage: …,
 //   mean-value coordinates, optimisation); returning false from ctx.progress cancels.
 // partTransfer: hierarchical part transfer (paper 000 Sec. 4.3): the whole-body transfer, then
@@ -28,7 +30,8 @@
 //     fixedCageVertices (its transfer ran in the level-1 cage, this many cage vertices held),
 //     seamDihedralMean,
 //     seamDihedralMax, ms}] (transfer order, depth first), folds {reference, source, level1,
-//     result, flipsLevel1, flips}, foldRetry (as transfer's, for the whole two-level run),
+//     result, flipsLevel1, flips}, foldRetry and flipRepair (as transfer's, for the whole
+//     two-level run),
 //     ms {level1, parts, total}}
 // compare: options {slotA = 'main', slotB = 'reference'} (same vertex order); buffers
 //   {positionsA?: welded #V·3} compares those positions (e.g. a transfer result) instead of slotA's
@@ -61,6 +64,7 @@ function poseInfo(r) {
     gammaDominance: r.gammaDominance, iterations: r.iterations, converged: r.converged,
     couplingIterations: r.couplingIterations, ms: r.ms, k: r.k, gamma: Array.from(r.gamma),
     foldRetry: r.foldRetry,
+    flipRepair: r.flipRepair,
   };
 }
 
@@ -102,6 +106,7 @@ export const ops = {
         parts: r.parts.map(({ sourceVertices, ...p }) => p),
         folds: r.folds,
         foldRetry: r.foldRetry,
+        flipRepair: r.flipRepair,
         ms: r.ms,
       },
     };
