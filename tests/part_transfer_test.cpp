@@ -219,13 +219,16 @@ TEST(PartRegions, DiskPlaneAndErrors) {
 // keep the one whose landmarks land closest, and propose again on that result (up to three
 // rounds, six parts a set); each part's transfer runs in the level-1 cage where that still
 // encloses it. Issue 16 asks for a lower aligned error than one level on every pair and ≥ 35%
-// lower where limbs move. Measured native / wasm: cat-05 −57 / −59 %, cat-01 −44 / −41 %, cat-07
-// −42 / −39 %, horse15 −41 / −43 %, lion-05 −42 / −53 %, lion-01 −31 / −37 %, lion-07 −9.9 /
-// −8.2 % (a lion lying with folded legs: level 1 stretches them, and the parts proposed there
-// fold or leave a seam; its first pass ends with 5 flipped faces, so level 1 and the parts run
-// again on the finer cage grid — PoseTransferOptions::fold_retry_resolution — and end with
-// none). The 35 % is asserted where both builds reach it. The builds pick different sets and gate decisions where two come close (their part
-// transfers differ in the last bits), so the bounds below hold both, with ~10 % margin.
+// lower where limbs move. Measured native / wasm (twenty-third session: a glued part that flips
+// faces goes through the flip repair before the gate instead of being rejected): cat-05 −57 / −59 %,
+// cat-01 −40 / −40 %, cat-07 −46 / −48 %, horse15 −58 / −56 %, lion-05 −49 / −49 %,
+// lion-01 −44 / −49 %, lion-07 −43 / −40 % (a lion lying with folded legs; its first pass
+// ends with flipped faces, so level 1 and the parts run again on the finer cage grid —
+// PoseTransferOptions::fold_retry_resolution — and end with none). Before the repair in the gate
+// lion-01 reached −31 % and lion-07 −10 %: the parts at their legs were rejected for one or two
+// flipped faces at the seam. The 35 % is asserted on every pair. The builds pick different sets
+// and gate decisions where two come close (their part transfers differ in the last bits), so the
+// bounds below hold both, with ~10 % margin.
 struct PartPairCase {
   const char* pose;
   const char* rest;
@@ -303,9 +306,9 @@ INSTANTIATE_TEST_SUITE_P(Pairs, PartTransferSame,
                          testing::Values(PartPairCase{"pose/cat-01.ply", "pose/cat-reference.ply", true, 0.041, 0.35},
                                          PartPairCase{"pose/cat-05.ply", "pose/cat-reference.ply", true, 0.025, 0.35},
                                          PartPairCase{"pose/cat-07.ply", "pose/cat-reference.ply", true, 0.054, 0.35},
-                                         PartPairCase{"pose/lion-01.ply", "pose/lion-reference.ply", true, 0.043},
+                                         PartPairCase{"pose/lion-01.ply", "pose/lion-reference.ply", true, 0.035, 0.35},
                                          PartPairCase{"pose/lion-05.ply", "pose/lion-reference.ply", true, 0.024, 0.35},
-                                         PartPairCase{"pose/lion-07.ply", "pose/lion-reference.ply", true, 0.087},
+                                         PartPairCase{"pose/lion-07.ply", "pose/lion-reference.ply", true, 0.057, 0.35},
                                          PartPairCase{"pose/horse15.ply", "pose/horse0.ply", true, 0.029, 0.35}),
                          pair_case_name);
 
@@ -356,7 +359,7 @@ TEST(PartTransferDifferent, CatToLionHorseToCamelMichaelToArmadillo) {
   for (const Case& c : {Case{"pose/cat-01.ply", "pose/lion-reference.ply", "landmarks/cat-lion.json", "pose/lion-01.ply", 0.75},
                         Case{"pose/horse0.ply", "pose/camel_ref.ply", "landmarks/horse0-camel_ref.json", nullptr, 0.95},
                         Case{"../../shared/data/pose/tosca/michael9.off", "edit/armadillo.ply", "landmarks/michael3-armadillo.json",
-                             nullptr, 0.97}}) {
+                             nullptr, 0.9}}) {
     if (!std::filesystem::exists(test::data_path(c.ref))) {
       std::printf("[ parts ] %s not in this checkout (../shared/data): skipped\n", c.ref);
       continue;
@@ -397,8 +400,9 @@ TEST(PartTransferDifferent, CatToLionHorseToCamelMichaelToArmadillo) {
                        r.folds_level1.self_intersections_result));
     // Issue 16: a lower landmark error than one level. The parts' own transfers fold here (7–9
     // landmarks per part), so most parts that are kept are the rigidly turned ones
-    // (rigid_when_folded). Measured (native / wasm): cat → lion −33 % / −31 % (ground truth
-    // −41 % / −37 %), horse → camel −8.2 % / −8.4 %, michael → armadillo −7.1 % / −7.2 %.
+    // (rigid_when_folded). Measured (native / wasm, twenty-third session): cat → lion −35 % / −32 %
+    // (ground truth −43 % / −34 %), horse → camel −8.4 % / −8.4 %, michael → armadillo −20 % (native
+    // only; 41 → 0 flipped faces).
     EXPECT_LE(l2, c.max_landmark_ratio * l1);
     if (c.gt) EXPECT_LE(g2, 0.75 * g1);  // lion-01: Sumner's own transfer of cat-01, never seen by the method
   }
@@ -473,7 +477,9 @@ TEST(PartTransferJob, NestedPartsFromAFile) {
 // Held out: the same-connectivity pairs of ../shared/data that the repository does not carry
 // (Sumner's horse, TOSCA's michael at 52k vertices). The proposal windows were chosen on the
 // pairs above; these check them on others (one round, four parts: horse-03 −11 %, horse-07 −3 %,
-// michael9 0; three rounds of six parts in the level-1 cage: −52 %, −61 %, −26 %). Skipped in a fresh clone without ../shared.
+// michael9 0; three rounds of six parts in the level-1 cage: −52 %, −61 %, −26 %; with the flip
+// repair in the gate: −51 %, −62 %, −37 % and michael9's 128 flipped faces of level 1 down to 9).
+// Skipped in a fresh clone without ../shared.
 INSTANTIATE_TEST_SUITE_P(HeldOut, PartTransferSame,
                          testing::Values(PartPairCase{"../../shared/data/pose/sumner/horse-03.obj", "../../shared/data/pose/sumner/horse_ref.obj", true, 0.029, 0.35},
                                          PartPairCase{"../../shared/data/pose/sumner/horse-07.obj", "../../shared/data/pose/sumner/horse_ref.obj", true, 0.020, 0.35},

@@ -1,4 +1,5 @@
 #include "transfer/part_transfer.h"
+#include "transfer/flip_repair.h"
 
 #include <algorithm>
 #include <atomic>
@@ -469,8 +470,10 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
                                "part transfer: need seam_rings >= 1, min_part_vertices >= 0, max_subdivisions in 0..3");
     return out;
   }
-  // Level 1: the whole body.
-  out.level1 = pose_transfer(reference, source, landmarks, opt.transfer, progress.sub(0.0, 0.4));
+  // Level 1: the whole body (its flips are repaired with the parts: in the gate and at the end).
+  PoseTransferOptions level1_opt = opt.transfer;
+  level1_opt.flip_repair_rings = 0;
+  out.level1 = pose_transfer(reference, source, landmarks, level1_opt, progress.sub(0.0, 0.4));
   out.ms_level1 = part_ms_since(t_start);
   if (!(out.status = out.level1.status).ok()) return out;
   out.V_level1 = out.level1.V;
@@ -707,8 +710,19 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     // Quality gate: keep the part only if it brings the level's landmark pairs closer to the
     // reference (after a similarity fit), adds no self-intersection and no flipped face, and
     // leaves no seam.
+    int flips_after = transfer_metrics(fin.V, source.V, source.F).flipped_faces;
+    if (flips_after > flips_current && opt.transfer.flip_repair_rings > 0) {
+      // The glued part folds faces (at its seam, usually): the flip repair first, then the gate.
+      FlipRepairOptions fo;
+      fo.rings = opt.transfer.flip_repair_rings;
+      FlipRepairResult fr = repair_flips(source, fin.V, fo);
+      if (fr.status.ok() && fr.flipped_after < flips_after) {
+        rep.flips_repaired = flips_after - fr.flipped_after;
+        flips_after = fr.flipped_after;
+        fin.V = std::move(fr.V);
+      }
+    }
     const int si_after = self_intersections(fin.V, source.F).pairs;
-    const int flips_after = transfer_metrics(fin.V, source.V, source.F).flipped_faces;
     rep.landmark_error_before = lm_error(Vcur);
     rep.landmark_error_after = lm_error(fin.V);
     rep.self_intersections_added = si_after - si_current;
@@ -820,7 +834,6 @@ PartTransferResult part_transfer(const Mesh& reference, const Mesh& source, cons
   const bool may_retry = finer > opt.transfer.cage.resolution;
   PartTransferOptions first = opt;
   first.transfer.fold_retry_resolution = 0;
-  first.transfer.flip_repair_rings = 0;  // the final result's flips are repaired below
   // The first pass's progress: level 1 in 0..0.4; its parts end at 1, or at 0.7 when level 1
   // folds (a second pass may follow in 0.7..1).
   std::atomic<bool> second_pass_likely{false};

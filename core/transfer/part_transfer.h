@@ -179,6 +179,7 @@ struct PartReport {
   // intersecting pairs and flipped faces the part added; rejected parts keep the previous shape.
   double landmark_error_before = 0, landmark_error_after = 0;
   int self_intersections_added = 0, flips_added = 0;
+  int flips_repaired = 0;  // flipped faces the glued part had that the flip repair removed before the gate
   bool rejected = false;
 };
 
