@@ -199,7 +199,7 @@ std::string transfer_summary(const TransferJobResult& r, const PoseTransferOptio
   }
   const FlipRepair& repair = r.hierarchical ? r.parts.flip_repair : t.flip_repair;
   if (repair.tried) {
-    std::snprintf(buf, sizeof buf, "  flip repair: %d flipped faces relaxed (%s), %.0f ms\n", repair.flipped_before,
+    std::snprintf(buf, sizeof buf, "  flip repair: %d flipped faces, their neighbourhood solved again (%s), %.0f ms\n", repair.flipped_before,
                   repair.kept ? ("kept: " + std::to_string(repair.moved_vertices) + " vertices moved").c_str()
                               : "not kept (no fewer folds)",
                   repair.ms);

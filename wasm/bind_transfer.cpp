@@ -14,7 +14,7 @@
 //                    inputSelfIntersections, ms} (PoseTransferOptions::fold_retry_resolution: the
 //                    first result folded, the cage was built again on the finer grid),
 //        flipRepair: {tried, kept, flippedBefore, movedVertices, ms} (flip_repair_rings: the
-//                    result still flipped faces, their neighbourhood was relaxed),
+//                    result still flipped faces, their neighbourhood was solved again),
 //        ms: {eigenbases, coupling, cage, mvc, optimisation, total}}
 //   partTransfer(refPositions, refIndices, srcPositions, srcIndices, landmarks, parts, options?,
 //                partOptions?, progress?)   hierarchical part transfer (paper 000 Sec. 4.3, issue 16)

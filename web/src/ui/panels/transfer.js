@@ -608,7 +608,7 @@ export const panel = {
       }
       const repair = parts ? parts.flipRepair : info.flipRepair;
       if (repair?.tried) {
-        rows.push(['flip repair', `${repair.flippedBefore} flipped face${repair.flippedBefore === 1 ? '' : 's'} relaxed as rigidly as possible: ${repair.kept ? `kept (${repair.movedVertices} vertices moved)` : 'not kept (no fewer folds)'} (${fixed(repair.ms / 1000)} s)`]);
+        rows.push(['flip repair', `${repair.flippedBefore} flipped face${repair.flippedBefore === 1 ? '' : 's'} solved again around them: ${repair.kept ? `kept (${repair.movedVertices} vertices moved)` : 'not kept (no fewer folds)'} (${fixed(repair.ms / 1000)} s)`]);
       }
       if (parts) {
         const kept = keptParts(parts.parts).length;

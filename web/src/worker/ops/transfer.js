@@ -12,7 +12,7 @@
 //       foldRetry {tried, kept, resolution, firstFlips, firstSelfIntersections,
 //       inputSelfIntersections, ms} (the first result folded: the cage was built on a finer grid),
 //       flipRepair {tried, kept, flippedBefore, movedVertices, ms} (the result still flipped faces:
-//       their neighbourhood was relaxed as rigidly as possible)}
+//       their neighbourhood was solved again: transfer/flip_repair.h)}
 //   Progress messages carry the core's stages (eigenbasis, coupled bases, cage: …,
 //   mean-value coordinates, optimisation); returning false from ctx.progress cancels.
 // partTransfer: hierarchical part transfer (paper 000 Sec. 4.3): the whole-body transfer, then
