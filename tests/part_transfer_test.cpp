@@ -263,12 +263,12 @@ TEST_P(PartTransferSame, TwoLevelsAgainstOneLevel) {
   if (c.improves) EXPECT_LT(e2, e1);
   EXPECT_GE(1 - e2 / e1, c.min_gain);
   EXPECT_LT(e2, c.max_error);
-  // No flips beyond level 1's, no self-intersections beyond the bound (or level 1's count).
+  // No flips beyond level 1's, and issue 16's bound on self-intersections: no more intersecting
+  // triangle pairs than the reference and the source together (measured, native / wasm: at most
+  // 423 against 1649 on cat-07; horse15 293 / 412 against 732).
   EXPECT_LE(m2.flipped_faces, m1.flipped_faces);
   EXPECT_EQ(r.folds.flipped_faces, m2.flipped_faces);
-  EXPECT_LE(r.folds.self_intersections_result,
-            std::max(r.folds.self_intersections_reference + r.folds.self_intersections_source,
-                     r.folds_level1.self_intersections_result));
+  EXPECT_LE(r.folds.self_intersections_result, r.folds.self_intersections_reference + r.folds.self_intersections_source);
   // Seams of the parts kept: mean dihedral-angle change across the cut edges below 20°
   // (measured 2.8–16°; level 1 had 1.7–7° there), none folded over (< 150°).
   for (const PartReport& p : r.reports) {
@@ -282,7 +282,8 @@ TEST_P(PartTransferSame, TwoLevelsAgainstOneLevel) {
   if (!r.fold_retry.kept)
     EXPECT_TRUE(std::any_of(r.reports.begin(), r.reports.end(),
                             [](const PartReport& p) { return p.cage_reused && p.fixed_cage_vertices > 0; }));
-  // Issue 16: no flips. michael9 → michael3 keeps 128 (level 1 has them on either cage grid).
+  // Issue 16: no flips. michael9 → michael3 keeps 9 (level 1 has 128 on either cage grid; the flip
+  // repair in the gate and on the final result removes the others).
   if (c.no_flips) EXPECT_EQ(m2.flipped_faces, 0);
   // Deterministic: a second run is bit-identical (checked on one of the quicker pairs only).
   if (std::string(c.pose) == "pose/cat-05.ply") {
@@ -395,9 +396,9 @@ TEST(PartTransferDifferent, CatToLionHorseToCamelMichaelToArmadillo) {
     part_transfer_test::print_reports(c.ref, r);
     // No flips (the flip repair on the final result: michael9 → armadillo 20 → 0).
     EXPECT_EQ(m2.flipped_faces, 0);
-    EXPECT_LE(r.folds.self_intersections_result,
-              std::max(r.folds.self_intersections_reference + r.folds.self_intersections_source,
-                       r.folds_level1.self_intersections_result));
+    // Issue 16's bound (measured: cat → lion 315 / 302 against 1286, horse → camel 0 against 293,
+    // michael9 → armadillo 289 against 1628).
+    EXPECT_LE(r.folds.self_intersections_result, r.folds.self_intersections_reference + r.folds.self_intersections_source);
     // Issue 16: a lower landmark error than one level. The parts' own transfers fold here (7–9
     // landmarks per part), so most parts that are kept are the rigidly turned ones
     // (rigid_when_folded). Measured (native / wasm, twenty-third session): cat → lion −35 % / −32 %
