@@ -1303,14 +1303,18 @@ it('transfer parts: automatic parts on the crouching cat — proposed, transferr
   await page.setInputFiles('#tr-parts-load', partsFile);
   await page.waitForFunction(() => window.__meshmorph.state.transfer.parts === 'file', null, { timeout: 5000 });
   check(new RegExp(`${parts.length} part pair`).test(await page.textContent('#tr-parts-hint')), `hint after loading: ${await page.textContent('#tr-parts-hint')}`);
-  await page.click('#tr-run');
-  await page.waitForFunction((n) => window.__meshmorph.state.transfer.runs > n || window.__meshmorph.state.error, runs + 1, { timeout: 120000 });
-  await waitIdle(page, 120000);
-  check(!(await page.evaluate(() => window.__meshmorph.state.error)), `run from the part file failed: ${JSON.stringify(await page.evaluate(() => window.__meshmorph.state.error))}`);
-  const again = await page.evaluate(() => window.__meshmorph.hooks.transferResult());
-  const againDifference = maxDistance(again, result) / diagonal;
-  console.log(`     run again from the saved part file: max difference ${againDifference.toExponential(2)}·diag`);
-  check(againDifference === 0, `the saved parts give another mesh (${againDifference}·diag)`);
+  // The run from the file: Chromium only (CI time, twenty-fourth session: ~60 s in Firefox for
+  // the same wasm op; Firefox still saves and loads the file through its own download and picker).
+  if (browser !== 'firefox') {
+    await page.click('#tr-run');
+    await page.waitForFunction((n) => window.__meshmorph.state.transfer.runs > n || window.__meshmorph.state.error, runs + 1, { timeout: 120000 });
+    await waitIdle(page, 120000);
+    check(!(await page.evaluate(() => window.__meshmorph.state.error)), `run from the part file failed: ${JSON.stringify(await page.evaluate(() => window.__meshmorph.state.error))}`);
+    const again = await page.evaluate(() => window.__meshmorph.hooks.transferResult());
+    const againDifference = maxDistance(again, result) / diagonal;
+    console.log(`     run again from the saved part file: max difference ${againDifference.toExponential(2)}·diag`);
+    check(againDifference === 0, `the saved parts give another mesh (${againDifference}·diag)`);
+  }
   // A malformed part file is refused with a message; the loaded one stays.
   const badFile = path.join(shotDir, 'bad-parts.json');
   fs.writeFileSync(badFile, '{"parts": 3}');
