@@ -8,11 +8,15 @@
 #include <functional>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <mutex>
+#include <thread>
 #include <numeric>
 
 #include <Eigen/Geometry>
 
 #include "cage/enclosing_cage.h"
+#include "common/threads.h"
 #include "linalg/rigid_fit.h"
 #include "merge/cut.h"
 #include "mesh/butterfly.h"
@@ -477,8 +481,7 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
   out.ms_level1 = part_ms_since(t_start);
   if (!(out.status = out.level1.status).ok()) return out;
   out.V_level1 = out.level1.V;
-  Eigen::MatrixXd Vcur = out.V_level1;
-  out.folds_level1 = out.level1.fold_retry.checked ? out.level1.folds : fold_report(reference, source, Vcur);
+  out.folds_level1 = out.level1.fold_retry.checked ? out.level1.folds : fold_report(reference, source, out.V_level1);
   if (level1_folds) level1_folds->store(out.folds_level1.violations() > 0);
   if (stop_unless_below >= 0 && out.folds_level1.violations() >= stop_unless_below) {
     if (stopped) *stopped = true;
@@ -504,7 +507,7 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     }
     return sets;
   };
-  std::vector<PartsSpec> candidates = spec ? std::vector<PartsSpec>{*spec} : propose_sets(Vcur, &out.disagreement);
+  std::vector<PartsSpec> candidates = spec ? std::vector<PartsSpec>{*spec} : propose_sets(out.V_level1, &out.disagreement);
   const int rounds = spec ? 1 : std::max(1, opt.proposal_rounds);
 
   const int nS = source.num_vertices(), nR = reference.num_vertices();
@@ -519,11 +522,16 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     for (const PartPair& p : l) c += 1 + count_parts(p.children);
     return c;
   };
-  // Progress: the parts of round r's sets fill [0.45, 1] × (r − 1 + done / total) / rounds.
-  int total_parts = 0, round = 1;
-  int done = 0;
-  std::vector<PartReport>* reports = &out.reports;  // of the candidate being run
-  // Running fold counts of Vcur and the level's landmark error (quality gate, see transfer_part).
+  int round = 1;
+  // One candidate set's run: its result so far, the running fold counts of that result (quality
+  // gate, see transfer_part) and the reports of its parts. The sets of a round run side by side
+  // (each from the round's base), so each has its own.
+  struct SetRun {
+    Eigen::MatrixXd V;
+    int si = 0, flips = 0;
+    std::vector<PartReport> reports;
+    int done = 0, total = 0;  // parts run / in the set (progress)
+  };
   int si_current = out.folds_level1.self_intersections_result;
   int flips_current = out.folds_level1.flipped_faces;
   const std::vector<LandmarkPair>& level_pairs = out.level1.landmarks;
@@ -536,17 +544,36 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     return aligned_vertex_error(lm, lm_ref);
   };
 
-  // One part pair (header, steps 1–5) on the current result Vcur.
-  auto transfer_part = [&](const PartPair& pp, int level) -> Status {
+  // Transfer I of the part pairs run so far (step 3), by their exact inputs: the sets of a round
+  // and the rounds share many parts (two neck windows often cut the same limb, and a part whose
+  // region no earlier glue touched sees the same positions again), and the transfer depends only
+  // on the two submeshes and the level-1 cage. A hit is the same result bit for bit (lion-07: 11
+  // of ~40 part transfers, 9 % of the run). Shared by the sets running side by side.
+  struct CachedPartTransfer {
+    std::vector<int> sset, rset;
+    Eigen::MatrixXd SV;
+    PoseTransferResult t;
+    bool cage_reused = false;
+  };
+  std::vector<std::shared_ptr<const CachedPartTransfer>> part_cache;
+  std::mutex part_cache_mutex;
+  auto cached_transfer = [&](const std::vector<int>& sset, const std::vector<int>& rset, const Eigen::MatrixXd& SV) {
+    std::lock_guard<std::mutex> lock(part_cache_mutex);
+    for (const auto& c : part_cache)
+      if (c->sset == sset && c->rset == rset && c->SV.rows() == SV.rows() && c->SV == SV) return c;
+    return std::shared_ptr<const CachedPartTransfer>();
+  };
+  // One part pair (header, steps 1–5) on the set's current result run.V. Progress: `set_progress`
+  // is the set's range, which its parts share in turn.
+  auto transfer_part = [&](SetRun& run, const PartPair& pp, int level, const Progress& set_progress) -> Status {
     const auto t0 = clock::now();
     PartReport rep;
     rep.name = pp.name;
     rep.level = level;
     rep.round = round;
-    const double span = 0.55 / rounds;
-    const Progress pp_progress = progress.sub(0.45 + span * (round - 1 + double(done) / std::max(1, total_parts)),
-                                              0.45 + span * (round - 1 + double(done + 1) / std::max(1, total_parts)));
-    ++done;
+    const Progress pp_progress = set_progress.sub(double(run.done) / std::max(1, run.total),
+                                                  double(run.done + 1) / std::max(1, run.total));
+    ++run.done;
     std::vector<int> sset, rset;
     if (Status s = part_vertices(source.V, source.F, pp.source, &sset); !s.ok())
       return Status::error(s.code, "part \"" + pp.name + "\" (source): " + s.message);
@@ -555,14 +582,14 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     } else if (Status s = part_vertices(reference.V, reference.F, pp.reference, &rset); !s.ok()) {
       return Status::error(s.code, "part \"" + pp.name + "\" (reference): " + s.message);
     }
-    PartMesh S = part_submesh(Vcur, source.F, sset);
+    PartMesh S = part_submesh(run.V, source.F, sset);
     PartMesh R = part_submesh(reference.V, reference.F, rset);
     rep.source_vertices = static_cast<int>(S.V.rows());
     rep.reference_vertices = static_cast<int>(R.V.rows());
     auto skip = [&](Status s) {
       rep.status = s;
       rep.ms = part_ms_since(t0);
-      reports->push_back(rep);
+      run.reports.push_back(rep);
       return Status::success();
     };
     if (S.boundary.empty() || R.boundary.empty() || S.tip < 0 || R.tip < 0)
@@ -587,17 +614,29 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     topt.placement = TransferPlacement::Reference;
     Mesh Sm{Ssub.V, Ssub.F}, Rm{Rsub.V, Rsub.F};
     // The level-1 cage where it still encloses the part (paper 000 Sec. 5), else its own.
-    Mesh level_cage;
-    if (opt.reuse_level_cage && out.level1.cage_deformed.rows() > 0) {
-      level_cage = Mesh{out.level1.cage_deformed, out.level1.cage_faces};
-      rep.cage_reused = check_user_cage(Sm.V, level_cage.V, &level_cage.F, topt.cage.min_clearance * 1e-3).ok();
-      if (rep.cage_reused) topt.fixed_cage_weight = opt.reused_cage_fixed_weight;
+    std::shared_ptr<const CachedPartTransfer> cached = cached_transfer(sset, rset, S.V);
+    rep.transfer_reused = cached != nullptr;
+    if (!cached) {
+      auto c = std::make_shared<CachedPartTransfer>();
+      Mesh level_cage;
+      if (opt.reuse_level_cage && out.level1.cage_deformed.rows() > 0) {
+        level_cage = Mesh{out.level1.cage_deformed, out.level1.cage_faces};
+        c->cage_reused = check_user_cage(Sm.V, level_cage.V, &level_cage.F, topt.cage.min_clearance * 1e-3).ok();
+        if (c->cage_reused) topt.fixed_cage_weight = opt.reused_cage_fixed_weight;
+      }
+      c->t = pose_transfer(Rm, Sm, lm, topt, pp_progress.sub(0.0, 0.8), c->cage_reused ? &level_cage : nullptr);
+      if (c->t.status.code == StatusCode::Cancelled) return c->t.status;
+      c->sset = sset, c->rset = rset, c->SV = S.V;
+      cached = c;
+      std::lock_guard<std::mutex> lock(part_cache_mutex);
+      part_cache.push_back(cached);
     }
-    const PoseTransferResult t = pose_transfer(Rm, Sm, lm, topt, pp_progress.sub(0.0, 0.8), rep.cage_reused ? &level_cage : nullptr);
+    rep.cage_reused = cached->cage_reused;
+    const PoseTransferResult& t = cached->t;
     rep.fixed_cage_vertices = t.fixed_cage_vertices;
     if (t.status.code == StatusCode::Cancelled) return t.status;
     rep.landmarks = static_cast<int>(t.landmarks.size());
-    rep.transfer_ms = t.ms;
+    if (!rep.transfer_reused) rep.transfer_ms = t.ms;
     if (!t.status.ok()) return skip(t.status);
     const auto t_glue = clock::now();
     Eigen::MatrixXd T;
@@ -692,15 +731,15 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     for (int v : handle) region.roi.push_back(v);
     std::sort(region.roi.begin(), region.roi.end());
     double l1_mean = 0, l1_max = 0;
-    part_seam_dihedral(Vcur, source.V, source.F, in_part, &l1_mean, &l1_max);
+    part_seam_dihedral(run.V, source.V, source.F, in_part, &l1_mean, &l1_max);
     LaplacianEditOptions eo;
     eo.handle_basis = false;
     LaplacianEditor editor;
-    if (Status s = editor.precompute(Vcur, source.F, region, eo, pp_progress.sub(0.8, 0.95)); !s.ok()) {
+    if (Status s = editor.precompute(run.V, source.F, region, eo, pp_progress.sub(0.8, 0.95)); !s.ok()) {
       if (s.code == StatusCode::Cancelled) return s;
       return skip(Status::error(s.code, "gluing: " + s.message));
     }
-    Eigen::MatrixXd targets = Vcur;
+    Eigen::MatrixXd targets = run.V;
     for (int i = 0; i < static_cast<int>(S.from.size()); ++i) targets.row(S.from[i]) = Treg.row(i);
     EditResult d = editor.drag_positions(targets);
     if (!d.status.ok()) return skip(Status::error(d.status.code, "gluing: " + d.status.message));
@@ -711,7 +750,7 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     // reference (after a similarity fit), adds no self-intersection and no flipped face, and
     // leaves no seam.
     int flips_after = transfer_metrics(fin.V, source.V, source.F).flipped_faces;
-    if (flips_after > flips_current && opt.transfer.flip_repair_rings > 0) {
+    if (flips_after > run.flips && opt.transfer.flip_repair_rings > 0) {
       // The glued part folds faces (at its seam, usually): the flip repair first, then the gate.
       FlipRepairOptions fo;
       fo.rings = opt.transfer.flip_repair_rings;
@@ -723,10 +762,10 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
       }
     }
     const int si_after = self_intersections(fin.V, source.F).pairs;
-    rep.landmark_error_before = lm_error(Vcur);
+    rep.landmark_error_before = lm_error(run.V);
     rep.landmark_error_after = lm_error(fin.V);
-    rep.self_intersections_added = si_after - si_current;
-    rep.flips_added = flips_after - flips_current;
+    rep.self_intersections_added = si_after - run.si;
+    rep.flips_added = flips_after - run.flips;
     part_seam_dihedral(fin.V, source.V, source.F, in_part, &rep.seam_dihedral_mean, &rep.seam_dihedral_max);
     rep.seam_dihedral_mean_before = l1_mean;
     rep.seam_dihedral_max_before = l1_max;
@@ -734,12 +773,12 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
       std::string why;
       // Issue 16's bound: no more self-intersecting pairs than the reference and the source
       // together (the Sumner poses themselves have 40–1565: limbs pressed against the body).
-      const int si_bound = std::max(si_current, out.folds_level1.self_intersections_reference +
+      const int si_bound = std::max(run.si, out.folds_level1.self_intersections_reference +
                                                     out.folds_level1.self_intersections_source);
       if (si_after > si_bound)
-        why += ", adds " + std::to_string(si_after - si_current) + " self-intersecting pairs (bound " +
+        why += ", adds " + std::to_string(si_after - run.si) + " self-intersecting pairs (bound " +
                std::to_string(si_bound) + ")";
-      if (flips_after > flips_current) why += ", adds " + std::to_string(flips_after - flips_current) + " flipped faces";
+      if (flips_after > run.flips) why += ", adds " + std::to_string(flips_after - run.flips) + " flipped faces";
       if (rep.landmark_error_after > rep.landmark_error_before) why += ", moves the landmarks away from the reference";
       if (rep.seam_dihedral_mean > opt.max_seam_dihedral_mean)
         why += ", leaves a seam (mean dihedral change " + std::to_string(static_cast<int>(std::lround(rep.seam_dihedral_mean))) +
@@ -749,22 +788,37 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
         return skip(Status::error(StatusCode::NotConverged, "rejected: the glued part" + why.substr(1)));
       }
     }
-    si_current = si_after;
-    flips_current = flips_after;
-    Vcur = fin.V;
+    run.si = si_after;
+    run.flips = flips_after;
+    run.V = fin.V;
     rep.glue_ms = part_ms_since(t_glue);
     rep.ms = part_ms_since(t0);
-    reports->push_back(rep);
+    run.reports.push_back(rep);
     return Status::success();
   };
-  std::function<Status(const std::vector<PartPair>&, int)> run_level = [&](const std::vector<PartPair>& list,
-                                                                          int level) -> Status {
+  std::function<Status(SetRun&, const std::vector<PartPair>&, int, const Progress&)> run_level =
+      [&](SetRun& run, const std::vector<PartPair>& list, int level, const Progress& set_progress) -> Status {
     for (const PartPair& pp : list) {
-      if (Status s = transfer_part(pp, level); !s.ok()) return s;
+      if (Status s = transfer_part(run, pp, level, set_progress); !s.ok()) return s;
       if (!pp.children.empty())
-        if (Status s = run_level(pp.children, level + 1); !s.ok()) return s;
+        if (Status s = run_level(run, pp.children, level + 1, set_progress); !s.ok()) return s;
     }
     return Status::success();
+  };
+  // The sets of a round run side by side (common/threads.h: on the calling thread and the pool;
+  // one after another with one thread). Each computes exactly what it would alone, so the result
+  // does not depend on the thread count. Only the calling thread reports to `progress`; a set on
+  // a pool thread only watches its cancel flag, which the calling thread's reports raise (it polls
+  // while it waits).
+  const std::thread::id caller = std::this_thread::get_id();
+  double shown = 0.45;  // the furthest point the calling thread reported (polled while it waits)
+  auto set_sink = [&](double begin, double end) {
+    const Progress range = progress.sub(begin, end);
+    return Progress([range, &progress, &shown, caller, begin, end](const std::string& stage, double f) {
+      if (std::this_thread::get_id() != caller) return !progress.cancelled();
+      shown = std::max(shown, begin + f * (end - begin));
+      return range.update(stage, f);
+    });
   };
   // Each candidate from the round's base (level 1 in the first round); the one whose level
   // landmark pairs end closest to the reference is kept. Within `proposal_tie` (relative) of the
@@ -777,42 +831,51 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
   double best = std::numeric_limits<double>::infinity();
   for (; round <= rounds; ++round) {
     if (round > 1) candidates = propose_sets(out.V, nullptr);
-    total_parts = 0;
-    for (const PartsSpec& c : candidates) total_parts += count_parts(c.parts);
-    done = 0;
-    const Eigen::MatrixXd base = out.V;
-    const int si_base = si_current, flips_base = flips_current;
-    int kept = -1, si_kept = si_base, flips_kept = flips_base;
-    Eigen::MatrixXd V_kept;
-    std::vector<PartReport> reports_kept;
-    for (size_t c = 0; c < candidates.size(); ++c) {
-      Vcur = base;
-      si_current = si_base, flips_current = flips_base;
-      std::vector<PartReport> tried;
-      reports = &tried;
-      if (Status s = run_level(candidates[c].parts, 2); !s.ok()) {
-        out.status = s;
+    const size_t n_sets = candidates.size();
+    // Progress: round r's sets fill [0.45, 1] × (r − 1 + (set + part / parts) / sets) / rounds.
+    const double span = 0.55 / rounds;
+    auto set_begin = [&](size_t c) { return 0.45 + span * (round - 1 + double(c) / std::max<size_t>(1, n_sets)); };
+    std::vector<SetRun> runs(n_sets);
+    std::vector<Status> statuses(n_sets);
+    for (size_t c = 0; c < n_sets; ++c) {
+      runs[c].V = out.V;
+      runs[c].si = si_current, runs[c].flips = flips_current;
+      runs[c].total = count_parts(candidates[c].parts);
+    }
+    auto run_set = [&](size_t c) {
+      statuses[c] = run_level(runs[c], candidates[c].parts, 2, set_sink(set_begin(c), set_begin(c + 1)));
+    };
+    {
+      std::vector<Task> others;
+      for (size_t c = 1; c < n_sets; ++c) others.emplace_back([&run_set, c] { run_set(c); });
+      if (n_sets > 0) run_set(0);
+      for (Task& t : others)
+        while (!t.wait_for(std::chrono::milliseconds(50))) progress.update("parts", shown);
+    }
+    for (const Status& st : statuses)
+      if (!st.ok()) {
+        out.status = st;  // the first set's error, or a cancel
         return out;
       }
-      const double e = lm_error(Vcur);
+    int kept = -1;
+    for (size_t c = 0; c < n_sets; ++c) {
+      const double e = lm_error(runs[c].V);
       // The first set of the first round always stands (a NaN error included).
       if ((round == 1 && c == 0) || e < best * (1 - opt.proposal_tie)) {
         best = e;
         kept = static_cast<int>(c);
-        V_kept = Vcur;
-        reports_kept = std::move(tried);
-        si_kept = si_current, flips_kept = flips_current;
       }
     }
-    out.proposals_tried += spec ? 0 : static_cast<int>(candidates.size());
+    out.proposals_tried += spec ? 0 : static_cast<int>(n_sets);
     if (kept < 0) break;  // no set of this round lands closer: the rounds are over
-    out.V = V_kept;
+    SetRun& k = runs[static_cast<size_t>(kept)];
+    out.V = std::move(k.V);
     out.landmark_error = best;
-    for (PartReport& r : reports_kept) out.reports.push_back(std::move(r));
+    for (PartReport& r : k.reports) out.reports.push_back(std::move(r));
     for (const PartPair& p : candidates[kept].parts) out.parts.parts.push_back(p);
     if (round == 1) out.proposal_kept = kept;
     out.proposal_rounds = round;
-    si_current = si_kept, flips_current = flips_kept;
+    si_current = k.si, flips_current = k.flips;
   }
   out.ms_parts = part_ms_since(t_parts);
   out.folds = fold_report(out.folds_level1, source, out.V);  // the inputs' counts from level 1

@@ -167,6 +167,7 @@ struct PartReport {
   bool rigid = false;            // registered rigidly instead (PartTransferOptions::rigid_when_folded)
   bool cage_reused = false;      // its transfer ran in the level-1 cage (PartTransferOptions::reuse_level_cage)
   int fixed_cage_vertices = 0;   // ... of which these were held
+  bool transfer_reused = false;  // this part pair on these positions was transferred before (in another set or round): that result, bit for bit
   // Seam: |change of dihedral angle| (degrees, against the source input) across the edges that
   // join the part to the rest, mean and max, after gluing and before this part was transferred.
   double seam_dihedral_mean = 0, seam_dihedral_max = 0;
