@@ -9,6 +9,7 @@
 #include "io/asset.h"
 #include "io/landmarks_file.h"
 #include "metrics/transfer_metrics.h"
+#include "transfer/part_transfer.h"
 #include "transfer/pose_transfer.h"
 
 namespace mm::bench {
@@ -129,9 +130,32 @@ void transfer_michael_armadillo(Context& ctx) {
   add_fold_rows(ctx, mesh, nv, R, S, pairs, r);
 }
 
+// Two levels (issue 16): cat-05 -> cat-reference with automatic parts (three rounds of three
+// candidate sets, run side by side on the pool since the twenty-fourth session). One run (~30-60 s
+// natively); not in --quick runs.
+void transfer_parts(Context& ctx) {
+  if (ctx.quick) return;
+  const std::string ref_path = ctx.find_data("pose/cat-05.ply"), src_path = ctx.find_data("pose/cat-reference.ply");
+  if (ref_path.empty() || src_path.empty()) return;
+  const io::LoadResult ref = io::load_asset(ref_path), src = io::load_asset(src_path);
+  if (!ref.status.ok() || !src.status.ok()) return;
+  const Mesh R = ref.asset.mesh(), S = src.asset.mesh();
+  const PartTransferResult r = part_transfer(R, S, {}, nullptr);
+  if (!r.status.ok()) {
+    std::fprintf(stderr, "  transfer: cat-05 parts: %s\n", r.status.message.c_str());
+    return;
+  }
+  int kept = 0;
+  for (const PartReport& p : r.reports) kept += p.status.ok();
+  ctx.add({"transfer", "cat-05->cat-reference", S.num_vertices(), "automatic parts (after level 1)", r.ms_parts, "",
+           std::to_string(r.proposals_tried) + " candidate sets in " + std::to_string(r.proposal_rounds) + " rounds, " +
+               std::to_string(kept) + " parts kept; level 1 " + std::to_string(static_cast<int>(r.ms_level1)) + " ms"});
+}
+
 void transfer_suites(Context& ctx) {
   transfer_suite(ctx);
   transfer_michael_armadillo(ctx);
+  transfer_parts(ctx);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "app/transfer_job.h"
+#include "common/threads.h"
 #include "io/landmarks_file.h"
 #include "io/parts_file.h"
 #include "merge/cut.h"
@@ -424,6 +425,37 @@ TEST(PartTransferDifferent, CatToLionHorseToCamelMichaelToArmadillo) {
     EXPECT_LE(l2, c.max_landmark_ratio * l1);
     if (c.gt) EXPECT_LE(g2, 0.75 * g1);  // lion-01: Sumner's own transfer of cat-01, never seen by the method
   }
+}
+
+// The sets of a round run side by side on the thread pool (part_transfer.cpp): one thread and
+// two give the same result, bit for bit, and the same reports in the same order. Natively only
+// (the single-threaded wasm build has one thread; tests/js/threads.test.mjs runs this on the
+// threaded build). One round of three sets of at most three parts keeps it short.
+TEST(PartTransferThreads, SetsSideBySideEqualOneThread) {
+#ifdef __EMSCRIPTEN__
+  GTEST_SKIP() << "one thread in this build";
+#endif
+  const Mesh P = test::load_mesh("pose/cat-05.ply"), S = test::load_mesh("pose/cat-reference.ply");
+  PartTransferOptions o;
+  o.max_parts = 3;
+  o.proposal_rounds = 1;
+  set_max_threads(1);
+  const PartTransferResult one = part_transfer(P, S, {}, nullptr, o);
+  set_max_threads(2);
+  const PartTransferResult two = part_transfer(P, S, {}, nullptr, o);
+  set_max_threads(0);
+  ASSERT_TRUE(one.status.ok()) << one.status.message;
+  ASSERT_TRUE(two.status.ok()) << two.status.message;
+  EXPECT_GE(one.proposals_tried, 2);
+  EXPECT_TRUE(one.V == two.V) << "one thread and two differ";
+  ASSERT_EQ(one.reports.size(), two.reports.size());
+  for (size_t i = 0; i < one.reports.size(); ++i) {
+    EXPECT_EQ(one.reports[i].name, two.reports[i].name);
+    EXPECT_EQ(one.reports[i].status.ok(), two.reports[i].status.ok());
+    EXPECT_EQ(one.reports[i].landmark_error_after, two.reports[i].landmark_error_after);
+  }
+  EXPECT_EQ(one.proposal_kept, two.proposal_kept);
+  EXPECT_EQ(one.proposal_rounds, two.proposal_rounds);
 }
 
 // A part file with a nested level through the job (what `meshmorph transfer --parts P.json

@@ -3,7 +3,8 @@
 // (the transfer's cage and mean-value coordinates beside the eigenbases, the mean-value rows in two
 // halves; the editor's Poisson factor beside the Eq. 7 system, whose columns and supernodal
 // factor are split in two; the retargeter's per-frame vertex product in column blocks) give the same bits as one thread and as the single-threaded build;
-// progress still comes from the calling thread only, and cancel stops a threaded run.
+// the automatic part sets run side by side; progress still comes from the calling thread only,
+// and cancel stops a threaded run.
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import { MeshMorphError } from '../../web/src/lib/errors.js';
@@ -65,6 +66,39 @@ test('cancel stops a two-thread transfer (the cage thread included); the module 
     const after = transferOps.transfer(ctx, { referenceSlot: 'reference', sourceSlot: 'source', method: 'yin' }).buffers.positions;
     const single = await withThreads('single', 1, (c) => transferCat(c));
     assert.ok(same(after, single), 'the run after a cancel differs');
+  });
+});
+
+// Automatic parts (one round of three candidate sets, at most three parts each): the sets run side
+// by side on the pool (core/transfer/part_transfer.cpp); one thread and two give the same bits, and
+// a cancel during the parts stops the sets on the pool threads too.
+function partsCat(ctx, progress) {
+  meshOps.load(ctx, { name: 'cat-05.ply', slot: 'reference' }, fileBuffers('pose/cat-05.ply'));
+  meshOps.load(ctx, { name: 'cat-reference.ply', slot: 'source' }, fileBuffers('pose/cat-reference.ply'));
+  if (progress) ctx.progress = progress;
+  return transferOps.partTransfer(ctx, { referenceSlot: 'reference', sourceSlot: 'source', parts: 'auto',
+    partOptions: { max_parts: 3, proposal_rounds: 1 } });
+}
+
+test('automatic parts: the candidate sets side by side give the same bits on one thread and two; cancel stops them', async () => {
+  const one = await withThreads('threaded', 1, (ctx) => partsCat(ctx));
+  const two = await withThreads('threaded', 2, (ctx) => partsCat(ctx));
+  assert.ok(one.info.proposals.tried >= 2, `${one.info.proposals.tried} candidate sets`);
+  assert.ok(same(one.buffers.positions, two.buffers.positions), 'automatic parts: one thread and two differ');
+  assert.deepEqual(two.info.parts.map((p) => [p.name, p.ok]), one.info.parts.map((p) => [p.name, p.ok]));
+  await withThreads('threaded', 2, async (ctx) => {
+    let cancelAt = 0;
+    assert.throws(() => partsCat(ctx, (stage, f) => {
+      if (f < 0.5) return true;
+      cancelAt ||= Date.now();
+      return false;
+    }), (e) => e instanceof MeshMorphError && e.code === 'Cancelled');
+    assert.ok(cancelAt > 0, 'the parts never reported past half way');
+    assert.ok(Date.now() - cancelAt < 5000, `the cancel took ${Date.now() - cancelAt} ms to stop the sets`);
+    // Every set has stopped before the op returns (its tasks are waited for): the module is free.
+    // (A run after a cancel equals a fresh one: the transfer cancel test above.)
+    ctx.progress = () => true;
+    assert.equal(meshOps.load(ctx, { name: 'cat-05.ply', slot: 'reference' }, fileBuffers('pose/cat-05.ply')).info.weldedVertices, 7207);
   });
 });
 
