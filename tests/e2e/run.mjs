@@ -1303,18 +1303,14 @@ it('transfer parts: automatic parts on the crouching cat — proposed, transferr
   await page.setInputFiles('#tr-parts-load', partsFile);
   await page.waitForFunction(() => window.__meshmorph.state.transfer.parts === 'file', null, { timeout: 5000 });
   check(new RegExp(`${parts.length} part pair`).test(await page.textContent('#tr-parts-hint')), `hint after loading: ${await page.textContent('#tr-parts-hint')}`);
-  // The run from the file: Chromium only (CI time, twenty-fourth session: ~60 s in Firefox for
-  // the same wasm op; Firefox still saves and loads the file through its own download and picker).
-  if (browser !== 'firefox') {
-    await page.click('#tr-run');
-    await page.waitForFunction((n) => window.__meshmorph.state.transfer.runs > n || window.__meshmorph.state.error, runs + 1, { timeout: 120000 });
-    await waitIdle(page, 120000);
-    check(!(await page.evaluate(() => window.__meshmorph.state.error)), `run from the part file failed: ${JSON.stringify(await page.evaluate(() => window.__meshmorph.state.error))}`);
-    const again = await page.evaluate(() => window.__meshmorph.hooks.transferResult());
-    const againDifference = maxDistance(again, result) / diagonal;
-    console.log(`     run again from the saved part file: max difference ${againDifference.toExponential(2)}·diag`);
-    check(againDifference === 0, `the saved parts give another mesh (${againDifference}·diag)`);
-  }
+  await page.click('#tr-run');
+  await page.waitForFunction((n) => window.__meshmorph.state.transfer.runs > n || window.__meshmorph.state.error, runs + 1, { timeout: 120000 });
+  await waitIdle(page, 120000);
+  check(!(await page.evaluate(() => window.__meshmorph.state.error)), `run from the part file failed: ${JSON.stringify(await page.evaluate(() => window.__meshmorph.state.error))}`);
+  const again = await page.evaluate(() => window.__meshmorph.hooks.transferResult());
+  const againDifference = maxDistance(again, result) / diagonal;
+  console.log(`     run again from the saved part file: max difference ${againDifference.toExponential(2)}·diag`);
+  check(againDifference === 0, `the saved parts give another mesh (${againDifference}·diag)`);
   // A malformed part file is refused with a message; the loaded one stays.
   const badFile = path.join(shotDir, 'bad-parts.json');
   fs.writeFileSync(badFile, '{"parts": 3}');
@@ -1451,8 +1447,10 @@ it('no console warnings or errors during the run', async ({ allConsole }) => {
 const firefoxTests = ['page loads', 'the default sample mesh renders', 'glTF materials', 'edit: ', 'transfer: ', 'transfer parts: ', 'retarget: ', 'merge: ', 'no console'];
 // Left to Chromium (CI time, eleventh session): the longest Firefox case (~21 s), whose controls
 // and worker ops the other Firefox retarget cases (Knight → Barbarian, Fox → wolf with automatic
-// joints and a pin, the person's own files) already drive.
-const firefoxSkip = ['retarget: KayKit clip onto the bundled human woman'];
+// joints and a pin, the person's own files) already drive. Twenty-fourth session: the automatic
+// parts case too (~140 s in Firefox, the CI's longest e2e case; the same wasm op and controls as
+// the Firefox transfer case's Run, and Chromium checks the parts, the file and the CLI).
+const firefoxSkip = ['retarget: KayKit clip onto the bundled human woman', 'transfer parts: '];
 
 // Installed in every page before its own scripts: the long-task observer (Chromium) and a
 // drop helper that dispatches dragenter / dragover / drop with a file at a fraction of the
