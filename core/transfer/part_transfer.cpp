@@ -633,8 +633,7 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     }
     rep.cage_reused = cached->cage_reused;
     const PoseTransferResult& t = cached->t;
-    rep.fixed_cage_vertices = t.fixed_cage_vertices;
-    if (t.status.code == StatusCode::Cancelled) return t.status;
+    rep.fixed_cage_vertices = t.fixed_cage_vertices;  // (a cancelled transfer returned above, never cached)
     rep.landmarks = static_cast<int>(t.landmarks.size());
     if (!rep.transfer_reused) rep.transfer_ms = t.ms;
     if (!t.status.ok()) return skip(t.status);
