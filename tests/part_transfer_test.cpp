@@ -297,11 +297,9 @@ TEST_P(PartTransferSame, TwoLevelsAgainstOneLevel) {
   // Issue 16: no flips. michael9 → michael3 keeps 9 (level 1 has 128 on either cage grid; the flip
   // repair in the gate and on the final result removes the others).
   if (c.no_flips) EXPECT_EQ(m2.flipped_faces, 0);
-  // Deterministic: a second run is bit-identical (checked on one of the quicker pairs only).
-  if (std::string(c.pose) == "pose/cat-05.ply") {
-    const PartTransferResult again = part_transfer(P, S, {}, nullptr);
-    EXPECT_TRUE(again.V == r.V) << "two runs differ";
-  }
+  // Deterministic runs: PartTransferThreads below (two runs, one thread and two, bit for bit) and
+  // threads.test.mjs on the threaded wasm build. (A second full run of cat-05 here cost ~25 s
+  // natively and ~50 s in wasm of CI time and checked nothing more.)
 }
 
 // Test name: the pose file's stem without dashes ("cat01").
