@@ -329,8 +329,24 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     await page.evaluate(() => window.__meshmorph.hooks.retargetSeek(1.0));
     await nextFrame(page);
     await shot(page, 'retarget-13-own-files');
+    const firstRun = await page.evaluate(() => window.__meshmorph.hooks.retargetFrame(10));
     const joints = await page.evaluate(() => window.__meshmorph.hooks.retargetJoints());
     check(joints.names.length === 19 && joints.names.includes('Skeleton_torso_joint_1'), `the file's joints were replaced: ${joints.names.slice(0, 3)}`);
+    // A cancel the op cannot honour in time (an SVD is one indivisible call; the CI's official
+    // run once lost a run that way): with no grace at all, Run pressed while preparing cancels the
+    // preparation, the worker is replaced, and the new run — made after the cancel — waits for
+    // the new worker instead of dying with the old one.
+    const restarts = await page.evaluate(() => window.__meshmorph.restarts);
+    await page.click('#rt-run');
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.run.status === 'preparing', null, { timeout: 10000 });
+    await page.evaluate(() => { window.__meshmorph.client.cancelGraceMs = 0; });
+    await page.click('#rt-run');
+    const again = await waitRun(page).finally(() => page.evaluate(() => { window.__meshmorph.client.cancelGraceMs = 2000; }));
+    const after = await page.evaluate(() => ({ restarts: window.__meshmorph.restarts, status: document.getElementById('status').textContent, error: window.__meshmorph.state.error }));
+    check(after.restarts === restarts + 1, `worker restarts ${restarts} → ${after.restarts} (one expected: the cancel had no grace)`);
+    check(again.run.frames === done.run.frames && !after.error, `the run after the restart: ${JSON.stringify(again.run)}, error ${JSON.stringify(after.error)}`);
+    const rerun = await page.evaluate(() => window.__meshmorph.hooks.retargetFrame(10));
+    check(rerun && rerun.length === firstRun.length && rerun.every((v, i) => v === firstRun[i]), 'the run in the new worker gives other positions');
     check(pageErrors.length === 0, `uncaught page errors: ${pageErrors.join(' | ')}`);
   });
   it('retarget: automatic joints — the Fox skeleton fitted inside the wolf, a joint dragged to pin it, refitted; both runs equal the CLI\'s (--target-joints auto, --markers)', async ({ page, browser, pageErrors }) => {

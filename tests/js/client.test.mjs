@@ -108,6 +108,36 @@ test('terminate cancel: a new worker replays the load; queued requests are abort
   }
 });
 
+test('a cancel that times out: requests made after it wait and run in the new worker, not Aborted; a waiting request cancels at once', async () => {
+  const restarts = [];
+  const { client, started } = makeClient({ cancelMode: 'cooperative', cancelGraceMs: 300, onRestart: (detail) => restarts.push(detail) });
+  try {
+    await loadArmadillo(client);
+    const blocking = client.run('block', { ms: 1500 }); // no progress: the flag is never read
+    await new Promise((resolve) => setTimeout(resolve, 100)); // it has started in the worker
+    assert.equal(client.cancel(blocking.id), true);
+    const after = client.run('eigs', { k: 3 }); // a new run replacing the cancelled one
+    const dropped = client.run('eigs', { k: 3 });
+    assert.equal(client.cancel(dropped.id), true, 'a request still waiting can be cancelled');
+    await assert.rejects(dropped.promise, (e) => e.code === 'Cancelled' && /before it started/.test(e.message));
+    await assert.rejects(blocking.promise, (e) => e.code === 'Cancelled' && /did not stop in time/.test(e.message));
+    const { info } = await after.promise;
+    assert.equal(info.weldedVertices, 14587, 'the new worker has the armadillo again');
+    assert.equal(client.restarts, 1);
+    assert.equal(started(), 2);
+    assert.deepEqual(restarts.map((r) => [r.code, r.why, r.restored]), [['Cancelled', 'did not stop in time', ['mesh:main']]]);
+    // A cancel that the op honours in time: no restart, and the request after it runs.
+    const quick = client.run('block', { ms: 100 });
+    client.cancel(quick.id);
+    const next = client.run('eigs', { k: 3 });
+    await quick.promise.catch((e) => assert.equal(e.code, 'Cancelled'));
+    assert.equal((await next.promise).buffers.eigenvalues.length, 3);
+    assert.equal(client.restarts, 1);
+  } finally {
+    client.dropWorker();
+  }
+});
+
 test('a worker that fails to start is replaced; after too many failures requests reject with InitFailed', async () => {
   const failInits = new Int32Array(new SharedArrayBuffer(4));
   Atomics.store(failInits, 0, 2);

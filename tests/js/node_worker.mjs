@@ -3,7 +3,8 @@
 // node build of the module.
 // Test hooks (workerData): failInits = Int32Array over a SharedArrayBuffer [failures left],
 // so a test can make the first starts fail; hangInits likewise makes them never answer; a
-// test-only 'crash' op simulates a wasm trap.
+// test-only 'crash' op simulates a wasm trap, and 'block' {ms} a long step that reports no
+// progress (one indivisible call, like an SVD), so a cooperative cancel cannot stop it.
 import { parentPort, workerData } from 'node:worker_threads';
 import { opFiles as pageOpFiles } from '../../web/src/worker/ops/index.js';
 import { createWorkerRuntime } from '../../web/src/worker/runtime.js';
@@ -13,6 +14,11 @@ const opFiles = { ...pageOpFiles };
 opFiles['test-hooks'] = {
   ops: {
     crash() { throw new WebAssembly.RuntimeError('unreachable executed (simulated trap)'); },
+    block(ctx, options = {}) {
+      const end = Date.now() + (options.ms ?? 1000);
+      while (Date.now() < end) { /* busy: no progress, no cancel check */ }
+      return { info: { blocked: options.ms }, buffers: {} };
+    },
   },
 };
 

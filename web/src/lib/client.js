@@ -15,7 +15,14 @@
 // of wasm memory (code OutOfMemory: the 4 GB heap never shrinks, so that worker would fail
 // again and again): the request fails with that code, the other pending ones with Aborted, and
 // `onRestart({why, code})` is called when the new worker has replayed the restore requests
-// (`restored`: their keys) — the page says so and panels drop state the old worker held.
+// (`restored`: their keys) — the page says so and panels drop state the old worker held. A
+// cancel that ends in a restart (2. above) calls it too, with code Cancelled: sessions (edit,
+// retarget) lived in the old worker.
+// Requests made while a cancel is pending wait until the cancelled request has ended (or its
+// worker was replaced) before they are posted: a new run that replaces a cancelled one (a
+// changed option, a new joints file) would otherwise sit in the old worker's queue and die
+// with it (Aborted) when the cancelled op does not stop in time — e.g. an SVD of the harmonic
+// map, one indivisible Eigen call, takes ~0.6 s on an idle machine and more under load.
 import { MeshMorphError, toMeshMorphError } from './errors.js';
 import { cloneBuffers, transferList } from './protocol.js';
 
@@ -44,6 +51,9 @@ export class MeshMorphClient {
     this.worker = null;
     this.cancelFlag = null;
     this.restarts = 0;          // how many times a worker was replaced (shown for tests)
+    this.cancelling = new Set(); // ids cancelled and not yet ended
+    this.cancelsEnded = null;    // {promise, resolve} while `cancelling` is not empty
+    this.unsent = new Map();     // id → reject, for run() requests still waiting to be posted
     this.ready = this.spawn();
   }
 
@@ -121,7 +131,16 @@ export class MeshMorphClient {
     const id = this.nextId++;
     let kept = null;
     if (restoreKey) kept = { op, options, buffers: cloneBuffers(buffers) };
-    const promise = this.whenReady().then(() => this.sendWithId(id, op, options, buffers, { onProgress })).then((result) => {
+    const promise = new Promise((resolve, reject) => {
+      this.unsent.set(id, reject);
+      this.whenReady().then(() => this.afterCancels()).then(() => {
+        if (!this.unsent.delete(id)) return; // cancelled while it waited: already rejected
+        this.sendWithId(id, op, options, buffers, { onProgress }).then(resolve, reject);
+      }, (e) => {
+        this.unsent.delete(id);
+        reject(e);
+      });
+    }).then((result) => {
       if (restoreKey) this.restore.set(restoreKey, kept);
       return result;
     });
@@ -144,6 +163,15 @@ export class MeshMorphClient {
       if (ready !== this.ready) continue;
       if (this.worker) return;
       this.ready = this.spawn(); // resolved but no worker: cannot normally happen; recover
+    }
+  }
+
+  // Resolves once no cancelled request is still running, on a ready worker (a cancel that
+  // timed out replaced it meanwhile).
+  async afterCancels() {
+    while (this.cancelsEnded) {
+      await this.cancelsEnded.promise;
+      await this.whenReady();
     }
   }
 
@@ -189,13 +217,30 @@ export class MeshMorphClient {
     if (entry?.cancelTimer) clearTimeout(entry.cancelTimer);
     if (this.cancelFlag && Atomics.load(this.cancelFlag, 0) === id) Atomics.store(this.cancelFlag, 0, 0);
     this.pending.delete(id);
+    if (this.cancelling.delete(id) && this.cancelling.size === 0 && this.cancelsEnded) {
+      const { resolve } = this.cancelsEnded;
+      this.cancelsEnded = null;
+      resolve();
+    }
   }
 
-  // Asks the request `id` to stop; it then rejects with code Cancelled. Returns false when
-  // the request is no longer running.
+  // Asks the request `id` to stop; it then rejects with code Cancelled (at once when it was
+  // still waiting to be posted). Returns false when the request is no longer running.
   cancel(id) {
+    const reject = this.unsent.get(id);
+    if (reject) {
+      this.unsent.delete(id);
+      reject(new MeshMorphError('Cancelled', 'cancelled before it started'));
+      return true;
+    }
     const entry = this.pending.get(id);
     if (!entry) return false;
+    this.cancelling.add(id);
+    if (!this.cancelsEnded) {
+      let resolve;
+      const promise = new Promise((r) => { resolve = r; });
+      this.cancelsEnded = { promise, resolve };
+    }
     if (this.cooperative) {
       Atomics.store(this.cancelFlag, 0, id);
       this.worker.postMessage({ type: 'cancel', id }); // for the case it is still queued
@@ -209,7 +254,8 @@ export class MeshMorphClient {
   }
 
   // Terminates the worker; `cancelledId` rejects with Cancelled, other pending requests with
-  // Aborted (their buffers went to the dead worker); then a new worker is started.
+  // Aborted (their buffers went to the dead worker); then a new worker is started, and
+  // onRestart tells the page (code Cancelled) once it has the restored state.
   restart(cancelledId, why) {
     const pending = [...this.pending.entries()];
     this.dropWorker();
@@ -220,6 +266,7 @@ export class MeshMorphClient {
     }
     this.restarts += 1;
     this.ready = this.spawn();
+    this.ready.then(() => this.onRestart({ why, code: 'Cancelled', restored: [...this.restore.keys()] }), () => {});
     return this.ready;
   }
 

@@ -97,16 +97,20 @@ export class Shell {
     });
   }
 
-  // The client replaced a worker that failed (crash, out of memory): the new one has loaded
-  // the meshes again. The error of the request that failed is already shown; this adds what
-  // happened next, and tells the panels ('restarted').
-  workerRestarted({ code, restored }) {
-    this.state.recoveries = (this.state.recoveries || 0) + 1;
+  // The client replaced a worker that failed (crash, out of memory) or that a cancel had to stop
+  // (code Cancelled): the new one has loaded the meshes again. The error of a request that failed
+  // is already shown; this adds what happened next, and tells the panels ('restarted').
+  workerRestarted({ code, why, restored }) {
     const meshes = restored.filter((k) => k.startsWith('mesh:')).length;
-    const text = `The geometry worker ${code === 'OutOfMemory' ? 'ran out of memory' : 'stopped'}; a new one was started`
+    const what = code === 'OutOfMemory' ? 'ran out of memory'
+      : code === 'Cancelled' ? (why === 'terminated' ? 'was stopped for a cancel' : 'did not stop in time for a cancel') : 'stopped';
+    const text = `The geometry worker ${what}; a new one was started`
       + `${meshes ? ` and ${meshes === 1 ? 'the loaded mesh was' : `the ${meshes} loaded meshes were`} restored` : ''}.`;
-    this.state.recovery = { code, restored, text };
-    if (this.state.error) this.errors.show({ code: this.state.error.code, message: `${this.state.error.message}\n${text}` });
+    if (code !== 'Cancelled') {
+      this.state.recoveries = (this.state.recoveries || 0) + 1;
+      this.state.recovery = { code, restored, text };
+      if (this.state.error) this.errors.show({ code: this.state.error.code, message: `${this.state.error.message}\n${text}` });
+    }
     this.notice(text);
     this.emit('restarted', { code, restored });
   }

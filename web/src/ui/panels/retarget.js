@@ -588,6 +588,12 @@ export const panel = {
         return r;
       } catch (e) {
         if (fitRequest !== req || e.code === 'Cancelled') return null;
+        if (e.code === 'Aborted') {
+          // Lost with a replaced worker (another request's cancel timed out): fitted again
+          // when the new worker is up ('restarted').
+          retarget.fit = { ...retarget.fit, status: 'aborted' };
+          return null;
+        }
         retarget.fit = { ...retarget.fit, status: 'error', error: e.message };
         runText('');
         if (!quiet) app.showError(e);
@@ -935,8 +941,15 @@ export const panel = {
         return;
       }
       if (type === 'error') {
-        run.status = 'error';
         const error = toMeshMorphError(detail.error);
+        if (error.code === 'Aborted') {
+          // Lost with a replaced worker, not failed: run again when the new one is up.
+          run.status = 'aborted';
+          runText('The geometry worker was replaced; the run starts again…');
+          refresh();
+          return;
+        }
+        run.status = 'error';
         run.error = { code: error.code, message: error.message };
         runText(`Failed: ${error.message}`);
         app.showError(error);
@@ -1135,8 +1148,18 @@ export const panel = {
       refresh();
     });
     app.on('restarted', () => {
-      // The sessions lived in the old worker.
-      if (retarget.run.status === 'frames' || retarget.run.status === 'preparing' || retarget.run.status === 'done') {
+      // The sessions lived in the old worker; a fit or a run lost with it starts again.
+      if (retarget.fit.status === 'aborted') {
+        retarget.fit = { ...retarget.fit, status: 'idle' };
+        if (retarget.jointsFrom === 'auto') {
+          runner.session = null;
+          chooseJoints();
+          return;
+        }
+      }
+      // A run still preparing was made after the cancel that replaced the worker (one made before
+      // it was Aborted): it waits for the new worker and needs nothing.
+      if (['frames', 'done', 'aborted'].includes(retarget.run.status)) {
         runner.session = null;
         startRun();
       }
