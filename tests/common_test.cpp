@@ -102,6 +102,25 @@ TEST(Tasks, ManyMoreTasksThanThreadsAllRunOnceAndNestedWaitsDoNotDeadlock) {
   for (size_t k = 0; k < runs.size(); ++k) EXPECT_EQ(runs[k].load(), 1) << "piece " << k;
 }
 
+// The wasm test binary is linked without -pthread from the -pthread objects the threaded modules
+// share (wasm/CMakeLists.txt): no thread can start there, so the core stays on one thread whatever
+// is asked. Natively threads exist.
+TEST(Tasks, ThreadsOnlyWhereTheLinkHasThem) {
+#if defined(__EMSCRIPTEN__)
+  EXPECT_FALSE(threads_supported());
+  ThreadCount four(4);
+  EXPECT_EQ(max_threads(), 1);
+  std::atomic<int> ran{0};
+  Task t([&] { ran += 1; });
+  t.wait();
+  EXPECT_EQ(ran.load(), 1);
+#else
+  EXPECT_TRUE(threads_supported());
+  ThreadCount four(4);
+  EXPECT_EQ(max_threads(), 4);
+#endif
+}
+
 TEST(Tasks, WaitRethrowsTheWorksExceptionAndTheDestructorWaits) {
   ThreadCount two(2);
   Task bad([] { throw std::runtime_error("boom"); });
@@ -125,7 +144,7 @@ TEST(Tasks, WaitRethrowsTheWorksExceptionAndTheDestructorWaits) {
     while (!release.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   });
   const Release on_exit{release};  // destroyed before `held`
-  if (MM_HAS_THREADS) {  // (without threads the work runs in wait_for below, after the release)
+  if (threads_supported()) {  // (without threads the work runs in wait_for below, after the release)
     for (int i = 0; i < 10000 && !started.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     ASSERT_TRUE(started.load()) << "no pool thread took the task within 10 s";
     EXPECT_FALSE(held.wait_for(std::chrono::milliseconds(5)));

@@ -4,7 +4,7 @@
 // JS API:
 //   optionSchema(job: "edit" | "merge" | "transfer" | "retarget" | "joints")  (app/jobs.h)
 //     → {ok, schema: {job, summary, options: [{name, kind, default, min?, max?, choices?, flag, help}]}}
-//   threads() → {ok, threaded: bool (the -pthread build), maxThreads: n}   (common/threads.h)
+//   threads() → {ok, threaded: bool (the -pthread link), maxThreads: n}   (common/threads.h)
 //   setMaxThreads(n: int) → the same object; n ≥ 1 caps the core's threads (1 = sequential,
 //     bit-identical results either way), n ≤ 0 restores the default (hardware concurrency)
 #include <string>
@@ -34,7 +34,7 @@ emscripten::val option_schema_js(const std::string& job) {
 
 emscripten::val threads_js() {
   emscripten::val out = status_object(Status::success());
-  out.set("threaded", MM_HAS_THREADS == 1);
+  out.set("threaded", threads_supported());
   out.set("maxThreads", max_threads());
   return out;
 }

@@ -6,8 +6,8 @@
 // - Gallery samples (web/src/lib/samples.js) and the Retarget job's characters and joints files
 //   (web/src/lib/clip-library.js) are served from data/ by the dev server and copied
 //   into the build under samples/, with data/licenses/.
-// - The threaded wasm build (`meshmorph_web_mt.*` from build/wasm-mt/wasm, override with
-//   MM_WASM_MT_DIR) is served and copied as plain files under wasm-mt/: its pthread workers load
+// - The threaded wasm modules (`meshmorph_web_mt.*`, beside the single-threaded ones in
+//   build/wasm/wasm; override with MM_WASM_MT_DIR) is served and copied as plain files under wasm-mt/: its pthread workers load
 //   the glue again by URL, so Vite must not bundle it. Missing, the page runs single-threaded.
 // - COOP/COEP headers make the page crossOriginIsolated, so SharedArrayBuffer exists (Cancel
 //   stops a computation without killing the worker, see web/src/lib/client.js, and the threaded
@@ -23,7 +23,7 @@ const webDir = path.dirname(fileURLToPath(import.meta.url));
 const repoDir = path.resolve(webDir, '..');
 const dataDir = path.join(repoDir, 'data');
 const wasmDir = path.resolve(repoDir, process.env.MM_WASM_DIR || 'build/wasm/wasm');
-const wasmThreadedDir = path.resolve(repoDir, process.env.MM_WASM_MT_DIR || 'build/wasm-mt/wasm');
+const wasmThreadedDir = path.resolve(repoDir, process.env.MM_WASM_MT_DIR || 'build/wasm/wasm');
 
 const isolationHeaders = {
   'Cross-Origin-Opener-Policy': 'same-origin',

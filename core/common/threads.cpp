@@ -10,6 +10,10 @@
 #include <thread>
 #include <vector>
 
+#if defined(__EMSCRIPTEN__) && MM_HAS_THREADS
+#include <emscripten/threading.h>
+#endif
+
 namespace mm {
 namespace {
 
@@ -33,14 +37,24 @@ int default_threads() {
 
 }  // namespace
 
-int max_threads() {
-  static const int d = default_threads();
+bool threads_supported() {
 #if !MM_HAS_THREADS
-  return d;  // 1: no threads in this build, whatever was asked
+  return false;
+#elif defined(__EMSCRIPTEN__)
+  // The -pthread link's library_pthread.js says yes; the stub library of a link without -pthread
+  // (the single-threaded modules, built from the same objects) says no.
+  static const bool supported = emscripten_has_threading_support() != 0;
+  return supported;
 #else
+  return true;
+#endif
+}
+
+int max_threads() {
+  if (!threads_supported()) return 1;  // whatever was asked
+  static const int d = default_threads();
   const int o = g_override.load();
   return o >= 1 ? o : d;
-#endif
 }
 
 void set_max_threads(int n) { g_override.store(n >= 1 ? n : 0); }

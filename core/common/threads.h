@@ -7,9 +7,11 @@
 // piece does the same arithmetic whichever thread runs it, so results are bit-identical whatever
 // the thread count.
 //
-// Where threads exist: natively, and in the wasm build with -pthread (MM_WASM_THREADS, the page's
-// module when crossOriginIsolated). The single-threaded wasm build compiles the threaded paths out
-// (MM_HAS_THREADS = 0) and max_threads() is 1 there. Only the calling thread reports progress: in
+// Where threads exist: natively, and in the wasm modules linked with -pthread (the page's module
+// when crossOriginIsolated). The wasm objects are compiled with -pthread once (MM_WASM_THREADS) and
+// linked twice: the single-threaded modules link them without shared memory, where pthreads are
+// stubs, so threads_supported() is false and max_threads() is 1 there. A wasm build compiled
+// without -pthread compiles the threaded paths out (MM_HAS_THREADS = 0). Only the calling thread reports progress: in
 // wasm the progress sink calls JavaScript, which lives on that thread alone.
 //
 // Tasks run on a small pool of long-lived threads, not on a thread per task: in wasm a finished
@@ -30,9 +32,13 @@
 
 namespace mm {
 
+// False where no thread can be started: a wasm module linked without -pthread (whatever its
+// objects were compiled with), or a build without threads.
+bool threads_supported();
+
 // Default: MM_THREADS from the environment when it is a positive integer (natively), else the
 // hardware's concurrency (navigator.hardwareConcurrency / node's CPU count in wasm), at least 1.
-// Always 1 without threads.
+// Always 1 without threads (threads_supported() false).
 int max_threads();
 // n ≥ 1 overrides the default (the bench's --threads, the wasm binding setMaxThreads); n ≤ 0
 // goes back to it. Not meant to be changed while a computation runs.

@@ -339,9 +339,9 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     const restarts = await page.evaluate(() => window.__meshmorph.restarts);
     await page.click('#rt-run');
     await page.waitForFunction(() => window.__meshmorph.state.retarget.run.status === 'preparing', null, { timeout: 10000 });
-    await page.evaluate(() => { window.__meshmorph.client.cancelGraceMs = 0; });
+    const grace = await page.evaluate(() => { const was = window.__meshmorph.client.cancelGraceMs; window.__meshmorph.client.cancelGraceMs = 0; return was; });
     await page.click('#rt-run');
-    const again = await waitRun(page).finally(() => page.evaluate(() => { window.__meshmorph.client.cancelGraceMs = 2000; }));
+    const again = await waitRun(page).finally(() => page.evaluate((ms) => { window.__meshmorph.client.cancelGraceMs = ms; }, grace));
     const after = await page.evaluate(() => ({ restarts: window.__meshmorph.restarts, status: document.getElementById('status').textContent, error: window.__meshmorph.state.error }));
     check(after.restarts === restarts + 1, `worker restarts ${restarts} → ${after.restarts} (one expected: the cancel had no grace)`);
     check(again.run.frames === done.run.frames && !after.error, `the run after the restart: ${JSON.stringify(again.run)}, error ${JSON.stringify(after.error)}`);

@@ -1,4 +1,4 @@
-// The threaded wasm build (-pthread, build/wasm-mt; the page's module when crossOriginIsolated)
+// The threaded wasm modules (the -pthread link of the same objects, meshmorph_node_mt; the page's module when crossOriginIsolated)
 // against the single-threaded one, through the worker's ops: the stages that run on two threads
 // (the transfer's cage and mean-value coordinates beside the eigenbases, the mean-value rows in two
 // halves; the editor's Poisson factor beside the Eq. 7 system, whose columns and supernodal

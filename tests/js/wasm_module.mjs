@@ -10,7 +10,7 @@ import { fileURLToPath } from 'node:url';
 export const repoDir = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 export const wasmDir = path.resolve(repoDir, process.env.MM_WASM_DIR || 'build/wasm/wasm');
 // The threaded build (-pthread, scripts/build wasm): MM_WASM_THREADED=1 runs the tests on it.
-export const wasmThreadedDir = path.resolve(repoDir, process.env.MM_WASM_MT_DIR || 'build/wasm-mt/wasm');
+export const wasmThreadedDir = path.resolve(repoDir, process.env.MM_WASM_MT_DIR || 'build/wasm/wasm');
 const threadedByDefault = process.env.MM_WASM_THREADED === '1';
 
 const modules = new Map(); // variant → Promise<module>

@@ -32,7 +32,7 @@ export class MeshMorphClient {
   // onStatus: (text) => void, for diagnostics (worker restarts).
   // startTimeoutMs: a worker that neither says 'ready' nor fails within this time is replaced
   // (doubling the wait each attempt: a slow machine compiling the module is not a hang).
-  constructor({ createWorker, threadedModuleUrl = null, maxInitAttempts = 3, startTimeoutMs = 30000, cancelGraceMs = 2000, cancelMode = 'auto', onStatus = () => {}, onRestart = () => {} }) {
+  constructor({ createWorker, threadedModuleUrl = null, maxInitAttempts = 3, startTimeoutMs = 30000, cancelGraceMs = 5000, cancelMode = 'auto', onStatus = () => {}, onRestart = () => {} }) {
     this.createWorker = createWorker;
     // The threaded wasm build needs shared memory: offered to the worker only when this page is
     // crossOriginIsolated (worker/worker.js falls back to the single-threaded build otherwise).

@@ -3,7 +3,7 @@
 // to the browser: which build of the wasm module to load, and the ops list (ops/index.js).
 //
 // Two builds of the module (docs/web.md, "Threads"):
-//  - threaded (-pthread, build/wasm-mt): needs shared memory, so only when this worker is
+//  - threaded (meshmorph_web_mt, the -pthread link): needs shared memory, so only when this worker is
 //    crossOriginIsolated and the client sent its URL ('init' message, threadedModuleUrl). It is
 //    served beside the page as plain files (wasm-mt/…, not bundled by Vite): its pthread
 //    workers load the same glue file again by URL.
