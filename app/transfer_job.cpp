@@ -90,6 +90,14 @@ std::string rigid_note(const PartReport& p) {
   return "rigid (its transfer folded " + std::to_string(p.transfer_flips) + " faces), rotation";
 }
 
+// "N flipped faces", and ", M collapsed faces" when some are crushed to a sheet (not flipped).
+std::string faulty_faces_text(int flipped, int collapsed) {
+  std::string t = std::to_string(flipped) + " flipped faces";
+  if (collapsed > 0) t += ", " + std::to_string(collapsed) + " collapsed faces";
+  return t;
+}
+std::string faulty_faces_text(const FoldReport& f) { return faulty_faces_text(f.flipped_faces, f.collapsed_faces); }
+
 // ", level-1 cage (N vertices held)" when the part's transfer reused the level-1 cage.
 std::string cage_note(const PartReport& p) {
   return p.cage_reused ? ", level-1 cage (" + std::to_string(p.fixed_cage_vertices) + " vertices held)" : "";
@@ -191,15 +199,16 @@ std::string transfer_summary(const TransferJobResult& r, const PoseTransferOptio
   if (retry.tried) {
     const FoldReport& a = retry.first;
     std::snprintf(buf, sizeof buf,
-                  "  %s on a %d-cell cage grid (the first result had %d flipped faces, %d self-intersecting pairs against %d in the inputs): %s, %.0f ms\n",
-                  r.hierarchical ? "level 1 and parts again" : "cage rebuilt", retry.resolution, a.flipped_faces,
+                  "  %s on a %d-cell cage grid (the first result had %s, %d self-intersecting pairs against %d in the inputs): %s, %.0f ms\n",
+                  r.hierarchical ? "level 1 and parts again" : "cage rebuilt", retry.resolution, faulty_faces_text(a).c_str(),
                   a.self_intersections_result, a.self_intersections_reference + a.self_intersections_source,
                   retry.kept ? "kept" : "not kept (no fewer folds)", retry.ms);
     s += buf;
   }
   const FlipRepair& repair = r.hierarchical ? r.parts.flip_repair : t.flip_repair;
   if (repair.tried) {
-    std::snprintf(buf, sizeof buf, "  flip repair: %d flipped faces, their neighbourhood solved again (%s), %.0f ms\n", repair.flipped_before,
+    std::snprintf(buf, sizeof buf, "  flip repair: %s, their neighbourhood solved again (%s), %.0f ms\n",
+                  faulty_faces_text(repair.flipped_before, repair.collapsed_before).c_str(),
                   repair.kept ? ("kept: " + std::to_string(repair.moved_vertices) + " vertices moved").c_str()
                               : "not kept (no fewer folds)",
                   repair.ms);
@@ -227,8 +236,8 @@ std::string transfer_summary(const TransferJobResult& r, const PoseTransferOptio
                     p.status.ok() ? "" : ", skipped: ", p.status.ok() ? "" : p.status.message.c_str());
       s += buf;
     }
-    std::snprintf(buf, sizeof buf, "  level 1: %d self-intersecting triangle pairs, %d flipped faces\n",
-                  r.parts.folds_level1.self_intersections_result, r.parts.folds_level1.flipped_faces);
+    std::snprintf(buf, sizeof buf, "  level 1: %d self-intersecting triangle pairs, %s\n",
+                  r.parts.folds_level1.self_intersections_result, faulty_faces_text(r.parts.folds_level1).c_str());
     s += buf;
   } else if (!r.parts.parts.parts.empty()) {
     std::snprintf(buf, sizeof buf, "  proposed %zu part pairs\n", r.parts.parts.parts.size());
@@ -236,9 +245,9 @@ std::string transfer_summary(const TransferJobResult& r, const PoseTransferOptio
   }
   const FoldReport& f = r.folds;
   std::snprintf(buf, sizeof buf,
-                "  folds: %d self-intersecting triangle pairs (reference %d, source %d)%s, %d flipped faces\n",
+                "  folds: %d self-intersecting triangle pairs (reference %d, source %d)%s, %s\n",
                 f.self_intersections_result, f.self_intersections_reference, f.self_intersections_source,
-                f.new_folds() ? " — more than the inputs together" : "", f.flipped_faces);
+                f.new_folds() ? " — more than the inputs together" : "", faulty_faces_text(f).c_str());
   return s + buf;
 }
 

@@ -34,7 +34,7 @@
 //        ms: {level1, parts, total}}
 //   transferMetrics(positionsA (#V·3), positionsB (#V·3), indices (#F·3))
 //     → {ok, vertexErrorMean, vertexErrorMax, laplacianChange, edgeDistortionMean,
-//        edgeDistortionMax, flippedFaces}
+//        edgeDistortionMax, flippedFaces, collapsedFaces}
 #include <string>
 #include <vector>
 
@@ -60,6 +60,7 @@ val fold_retry_object(const FoldRetry& f) {
   o.set("kept", f.kept);
   o.set("resolution", f.resolution);
   o.set("firstFlips", f.first.flipped_faces);
+  o.set("firstCollapsed", f.first.collapsed_faces);
   o.set("firstSelfIntersections", f.first.self_intersections_result);
   o.set("inputSelfIntersections", f.first.self_intersections_reference + f.first.self_intersections_source);
   o.set("ms", f.ms);
@@ -72,6 +73,7 @@ val flip_repair_object(const FlipRepair& f) {
   o.set("tried", f.tried);
   o.set("kept", f.kept);
   o.set("flippedBefore", f.flipped_before);
+  o.set("collapsedBefore", f.collapsed_before);
   o.set("movedVertices", f.moved_vertices);
   o.set("ms", f.ms);
   return o;
@@ -205,6 +207,8 @@ val part_transfer_js(val ref_positions, val ref_indices, val src_positions, val 
   folds.set("result", r.folds.self_intersections_result);
   folds.set("flipsLevel1", r.folds_level1.flipped_faces);
   folds.set("flips", r.folds.flipped_faces);
+  folds.set("collapsedLevel1", r.folds_level1.collapsed_faces);
+  folds.set("collapsed", r.folds.collapsed_faces);
   out.set("folds", folds);
   out.set("foldRetry", fold_retry_object(r.fold_retry));
   out.set("flipRepair", flip_repair_object(r.flip_repair));
@@ -229,6 +233,7 @@ val transfer_metrics_js(val a, val b, val indices) {
   out.set("edgeDistortionMean", m.edge_distortion_mean);
   out.set("edgeDistortionMax", m.edge_distortion_max);
   out.set("flippedFaces", m.flipped_faces);
+  out.set("collapsedFaces", m.collapsed_faces);
   return out;
 }
 

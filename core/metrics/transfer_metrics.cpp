@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <map>
+#include <iterator>
 #include <set>
 #include <utility>
 #include <vector>
@@ -87,7 +88,11 @@ TransferMetrics transfer_metrics(const Eigen::MatrixXd& A, const Eigen::MatrixXd
     }
   }
   out.edge_distortion_mean = count ? sum / count : 0.0;
-  out.flipped_faces = static_cast<int>(flipped_faces(A, B, F, face_neighbours(F)).size());
+  const std::vector<int> flipped = flipped_faces(A, B, F, face_neighbours(F)), collapsed = collapsed_faces(A, B, F);
+  out.flipped_faces = static_cast<int>(flipped.size());
+  std::vector<int> only_collapsed;
+  std::set_difference(collapsed.begin(), collapsed.end(), flipped.begin(), flipped.end(), std::back_inserter(only_collapsed));
+  out.collapsed_faces = static_cast<int>(only_collapsed.size());
   return out;
 }
 
@@ -113,6 +118,27 @@ std::vector<int> flipped_faces(const Eigen::MatrixXd& A, const Eigen::MatrixXd& 
   std::vector<int> out;
   for (int f = 0; f < F.rows(); ++f)
     if (agree_a[f] < 0 && agree_b[f] > 0.5) out.push_back(f);
+  return out;
+}
+
+std::vector<int> collapsed_faces(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXi& F) {
+  auto areas = [&F](const Eigen::MatrixXd& V) {
+    Eigen::VectorXd a(F.rows());
+    for (int f = 0; f < F.rows(); ++f) {
+      const Eigen::Vector3d p = V.row(F(f, 0)), q = V.row(F(f, 1)), r = V.row(F(f, 2));
+      a[f] = 0.5 * (q - p).cross(r - p).norm();
+    }
+    return a;
+  };
+  std::vector<int> out;
+  if (F.rows() == 0) return out;
+  const Eigen::VectorXd a = areas(A), b = areas(B);
+  const double sa = a.sum(), sb = b.sum();
+  if (!(sa > 0) || !(sb > 0)) return out;
+  // a_f / sa < 1e-3 · b_f / sb, without dividing by a rest area that may be 0.
+  const double k = 1e-3 * sa / sb;
+  for (int f = 0; f < F.rows(); ++f)
+    if (a[f] < k * b[f]) out.push_back(f);
   return out;
 }
 

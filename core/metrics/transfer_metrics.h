@@ -11,6 +11,9 @@
 //   mean normal of their edge-neighbouring faces in A but clearly agrees (dot > 0.5) in B —
 //   local fold-overs (slivers with ambiguous normals in B are not counted),
 //   independent of the global rotation of a pose.
+// - collapsed faces: faces whose area in A, relative to the whole surface's, is below 1e-3 of
+//   their relative area in B (a patch crushed to a sliver sheet; its normals are noise, so a
+//   file written in single precision shows them as flips); those not also flipped are counted.
 #pragma once
 
 #include <vector>
@@ -29,6 +32,7 @@ struct TransferMetrics {
   double edge_distortion_mean = 0;  // relative
   double edge_distortion_max = 0;
   int flipped_faces = 0;
+  int collapsed_faces = 0;
 };
 
 TransferMetrics transfer_metrics(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXi& F);
@@ -41,6 +45,9 @@ std::vector<std::vector<int>> face_neighbours(const Eigen::MatrixXi& F);
 // neighbours = face_neighbours(F).
 std::vector<int> flipped_faces(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXi& F,
                                const std::vector<std::vector<int>>& neighbours);
+
+// The collapsed faces of TransferMetrics (see header), ascending: A deformed, B its rest shape.
+std::vector<int> collapsed_faces(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXi& F);
 
 // Aligned vertex error: mean_i |s R a_i + t − b_i| / D (D = bbox diagonal of B) after the
 // least-squares similarity (Umeyama, linalg/rigid_fit.h) of A onto B, so that a global

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <iterator>
 #include <utility>
 #include <vector>
 
@@ -135,6 +136,20 @@ Status relax_region(const Mesh& rest, const std::vector<std::vector<WeightedEdge
   return Status{};
 }
 
+// The faces a repair must remove: flipped (a local fold) or collapsed (a patch crushed to a
+// sheet — what a membrane spanning a protrusion does: the cotangent-harmonic fill of a foot held
+// at the shin squeezes the toes by 1e-6 in area, leaving normals that are noise). Both counted,
+// ascending and without repeats.
+std::vector<int> faulty_faces(const Eigen::MatrixXd& X, const Mesh& rest, const std::vector<std::vector<int>>& fn,
+                              int* flipped_count) {
+  std::vector<int> f = flipped_faces(X, rest.V, rest.F, fn);
+  *flipped_count = static_cast<int>(f.size());
+  const std::vector<int> c = collapsed_faces(X, rest.V, rest.F);
+  std::vector<int> out;
+  std::set_union(f.begin(), f.end(), c.begin(), c.end(), std::back_inserter(out));
+  return out;
+}
+
 }  // namespace flip_repair_detail
 
 FlipRepairResult repair_flips(const Mesh& rest, const Eigen::MatrixXd& deformed, const FlipRepairOptions& opt,
@@ -144,23 +159,26 @@ FlipRepairResult repair_flips(const Mesh& rest, const Eigen::MatrixXd& deformed,
   FlipRepairResult out;
   out.V = deformed;
   const auto fn = face_neighbours(rest.F);
-  std::vector<int> flipped = flipped_faces(deformed, rest.V, rest.F, fn);  // of out.V
-  out.flipped_before = out.flipped_after = static_cast<int>(flipped.size());
-  if (!flipped.empty() && opt.rounds > 0 && opt.rings >= 0) {
+  int flipped_count = 0;
+  std::vector<int> faulty = faulty_faces(deformed, rest, fn, &flipped_count);  // of out.V
+  out.flipped_before = out.flipped_after = flipped_count;
+  out.collapsed_before = out.collapsed_after = static_cast<int>(faulty.size()) - flipped_count;
+  if (!faulty.empty() && opt.rounds > 0 && opt.rings >= 0) {
     const auto adj = vertex_adjacency(rest.F, static_cast<int>(rest.V.rows()));
     const auto E = rest_weights(rest);
-    for (int r = 0; r < opt.rounds && !flipped.empty(); ++r) {
+    for (int r = 0; r < opt.rounds && !faulty.empty(); ++r) {
       if (!progress.update("flip repair", static_cast<double>(r) / opt.rounds)) {
         out.status = cancelled_status("flip repair");
         break;
       }
-      // The region: the faces the best result so far still flips, grown by twice the rings
-      // each round.
-      const std::vector<int> free = k_ring(adj, face_vertices(rest.F, flipped), opt.rings << r);
-      // Both solves; the one leaving fewer flipped faces is kept (the detail one on a tie).
+      // The region: the faces the best result so far still flips (or has collapsed), grown by
+      // twice the rings each round.
+      const std::vector<int> free = k_ring(adj, face_vertices(rest.F, faulty), opt.rings << r);
+      // Both solves; the one leaving fewer faulty faces is kept (the detail one on a tie).
       bool stop = false;
       Eigen::MatrixXd best;
-      std::vector<int> best_flipped = flipped;
+      std::vector<int> best_faulty = faulty;
+      int best_flipped = flipped_count;
       bool best_membrane = false;
       for (const bool membrane : {false, true}) {
         Eigen::MatrixXd X = out.V;
@@ -169,22 +187,26 @@ FlipRepairResult repair_flips(const Mesh& rest, const Eigen::MatrixXd& deformed,
           stop = true;
           break;
         }
-        std::vector<int> now = flipped_faces(X, rest.V, rest.F, fn);
-        if (now.size() < best_flipped.size()) {
+        int now_flipped = 0;
+        std::vector<int> now = faulty_faces(X, rest, fn, &now_flipped);
+        if (now.size() < best_faulty.size()) {
           best = std::move(X);
-          best_flipped = std::move(now);
+          best_faulty = std::move(now);
+          best_flipped = now_flipped;
           best_membrane = membrane;
         }
       }
       if (!stop && best.size() > 0) {
         out.V = std::move(best);
-        flipped = std::move(best_flipped);
+        faulty = std::move(best_faulty);
+        flipped_count = best_flipped;
         if (!best_membrane) ++out.detail_rounds;
       }
       ++out.rounds;
       if (stop) break;
     }
-    out.flipped_after = static_cast<int>(flipped.size());
+    out.flipped_after = flipped_count;
+    out.collapsed_after = static_cast<int>(faulty.size()) - flipped_count;
     for (int i = 0; i < out.V.rows(); ++i) out.moved_vertices += out.V.row(i) != deformed.row(i);
   }
   out.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

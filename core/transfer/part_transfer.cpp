@@ -533,7 +533,7 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     int done = 0, total = 0;  // parts run / in the set (progress)
   };
   int si_current = out.folds_level1.self_intersections_result;
-  int flips_current = out.folds_level1.flipped_faces;
+  int flips_current = out.folds_level1.flipped_faces + out.folds_level1.collapsed_faces;  // faulty faces
   const std::vector<LandmarkPair>& level_pairs = out.level1.landmarks;
   Eigen::MatrixXd lm_ref(level_pairs.size(), 3);
   for (size_t k = 0; k < level_pairs.size(); ++k)
@@ -641,7 +641,8 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     Eigen::MatrixXd T;
     Eigen::MatrixXi Fc;
     butterfly_coarsen(t.V, Ssub.F, levels, static_cast<int>(S.V.rows()), &T, &Fc);
-    rep.transfer_flips = transfer_metrics(T, S.V, S.F).flipped_faces;
+    const TransferMetrics part_metrics = transfer_metrics(T, S.V, S.F);
+    rep.transfer_flips = part_metrics.flipped_faces + part_metrics.collapsed_faces;
     // Step 4: registration, rotation about the boundary centroid, then the boundary centroid onto
     // the level-1 one. By the paper's local frames; or rigidly (the level-1 shape turned onto the
     // part's landmarks) when the transfer folded faces.
@@ -748,15 +749,17 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     // Quality gate: keep the part only if it brings the level's landmark pairs closer to the
     // reference (after a similarity fit), adds no self-intersection and no flipped face, and
     // leaves no seam.
-    int flips_after = transfer_metrics(fin.V, source.V, source.F).flipped_faces;
+    // "flips" here: flipped or collapsed faces (metrics/transfer_metrics.h).
+    const TransferMetrics glued = transfer_metrics(fin.V, source.V, source.F);
+    int flips_after = glued.flipped_faces + glued.collapsed_faces;
     if (flips_after > run.flips && opt.transfer.flip_repair_rings > 0) {
       // The glued part folds faces (at its seam, usually): the flip repair first, then the gate.
       FlipRepairOptions fo;
       fo.rings = opt.transfer.flip_repair_rings;
       FlipRepairResult fr = repair_flips(source, fin.V, fo);
-      if (fr.status.ok() && fr.flipped_after < flips_after) {
-        rep.flips_repaired = flips_after - fr.flipped_after;
-        flips_after = fr.flipped_after;
+      if (fr.status.ok() && fr.flipped_after + fr.collapsed_after < flips_after) {
+        rep.flips_repaired = flips_after - fr.flipped_after - fr.collapsed_after;
+        flips_after = fr.flipped_after + fr.collapsed_after;
         fin.V = std::move(fr.V);
       }
     }
@@ -777,7 +780,7 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
       if (si_after > si_bound)
         why += ", adds " + std::to_string(si_after - run.si) + " self-intersecting pairs (bound " +
                std::to_string(si_bound) + ")";
-      if (flips_after > run.flips) why += ", adds " + std::to_string(flips_after - run.flips) + " flipped faces";
+      if (flips_after > run.flips) why += ", adds " + std::to_string(flips_after - run.flips) + " flipped or collapsed faces";
       if (rep.landmark_error_after > rep.landmark_error_before) why += ", moves the landmarks away from the reference";
       if (rep.seam_dihedral_mean > opt.max_seam_dihedral_mean)
         why += ", leaves a seam (mean dihedral change " + std::to_string(static_cast<int>(std::lround(rep.seam_dihedral_mean))) +

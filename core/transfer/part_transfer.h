@@ -163,7 +163,7 @@ struct PartReport {
   int seam_vertices = 0;         // vertices smoothed by the gluing step
   double rotation_degrees = 0;   // registration rotation (local frames, or the landmarks' when rigid)
   int round = 1;                 // automatic parts: the proposal round that gave it
-  int transfer_flips = 0;        // faces the part's Transfer I flipped against its level-1 shape
+  int transfer_flips = 0;        // faces the part's Transfer I flipped (or collapsed) against its level-1 shape
   bool rigid = false;            // registered rigidly instead (PartTransferOptions::rigid_when_folded)
   bool cage_reused = false;      // its transfer ran in the level-1 cage (PartTransferOptions::reuse_level_cage)
   int fixed_cage_vertices = 0;   // ... of which these were held
@@ -180,7 +180,7 @@ struct PartReport {
   // intersecting pairs and flipped faces the part added; rejected parts keep the previous shape.
   double landmark_error_before = 0, landmark_error_after = 0;
   int self_intersections_added = 0, flips_added = 0;
-  int flips_repaired = 0;  // flipped faces the glued part had that the flip repair removed before the gate
+  int flips_repaired = 0;  // flipped (or collapsed) faces the glued part had that the flip repair removed before the gate
   bool rejected = false;
 };
 

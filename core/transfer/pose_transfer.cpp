@@ -72,7 +72,9 @@ Status normalize(const Mesh& m, const char* which, Normalized* out) {
 FoldReport fold_report(const FoldReport& inputs, const Mesh& source, const Eigen::MatrixXd& result) {
   FoldReport r = inputs;
   r.self_intersections_result = self_intersections(result, source.F).pairs;
-  r.flipped_faces = transfer_metrics(result, source.V, source.F).flipped_faces;
+  const TransferMetrics m = transfer_metrics(result, source.V, source.F);
+  r.flipped_faces = m.flipped_faces;
+  r.collapsed_faces = m.collapsed_faces;
   return r;
 }
 
@@ -85,16 +87,17 @@ FoldReport fold_report(const Mesh& reference, const Mesh& source, const Eigen::M
 
 Status repair_transfer_flips(const Mesh& source, int rings, const Progress& progress, Eigen::MatrixXd* result,
                              FoldReport* folds, FlipRepair* record) {
-  if (rings <= 0 || folds->flipped_faces == 0) return Status{};
+  if (rings <= 0 || folds->flipped_faces + folds->collapsed_faces == 0) return Status{};
   FlipRepairOptions o;
   o.rings = rings;
   FlipRepairResult r = repair_flips(source, *result, o, progress);
   record->tried = true;
   record->flipped_before = folds->flipped_faces;
+  record->collapsed_before = folds->collapsed_faces;
   record->rounds = r.rounds;
   record->ms = r.ms;
   if (r.status.code == StatusCode::Cancelled) return r.status;
-  if (!r.status.ok() || r.flipped_after >= r.flipped_before) return Status{};
+  if (!r.status.ok() || r.flipped_after + r.collapsed_after >= r.flipped_before + r.collapsed_before) return Status{};
   const FoldReport repaired = fold_report(*folds, source, r.V);
   if (repaired.violations() < folds->violations()) {
     record->kept = true;

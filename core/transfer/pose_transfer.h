@@ -109,12 +109,14 @@ struct FoldReport {
   int self_intersections_source = 0;     // ... of the source (input)
   int self_intersections_result = 0;     // ... of the result
   int flipped_faces = 0;                 // result's local fold-overs against the source
+  int collapsed_faces = 0;               // result's faces crushed below 1e-3 of their area (not flipped)
   bool new_folds() const {               // more self-intersections than the inputs together
     return self_intersections_result > self_intersections_reference + self_intersections_source;
   }
-  // Flipped faces plus the self-intersecting pairs beyond the inputs' count (0 = no fold).
+  // Flipped and collapsed faces plus the self-intersecting pairs beyond the inputs' count (0 = no
+  // fold).
   int violations() const {
-    return flipped_faces +
+    return flipped_faces + collapsed_faces +
            std::max(0, self_intersections_result - self_intersections_reference - self_intersections_source);
   }
 };
@@ -139,6 +141,7 @@ struct FlipRepair {
   bool tried = false;       // the result flipped faces: the repair ran
   bool kept = false;        // ... and its result had fewer violations, so it is the one returned
   int flipped_before = 0;   // flipped faces before the repair
+  int collapsed_before = 0; // collapsed faces (not flipped) before the repair
   int moved_vertices = 0;   // vertices the kept repair moved
   int rounds = 0;           // regions tried
   double ms = 0;

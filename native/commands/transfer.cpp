@@ -81,6 +81,7 @@ int run_compare(const std::vector<std::string>& argv) {
   std::printf("Laplacian-coordinate magnitude change: %.6f\n", m.laplacian_change);
   std::printf("edge-length distortion: mean %.6f, max %.6f\n", m.edge_distortion_mean, m.edge_distortion_max);
   std::printf("flipped faces: %d\n", m.flipped_faces);
+  if (m.collapsed_faces > 0) std::printf("collapsed faces: %d (below 1/1000 of their area, not flipped)\n", m.collapsed_faces);
   return 0;
 }
 

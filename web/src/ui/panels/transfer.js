@@ -595,7 +595,7 @@ export const panel = {
       gammaMap.show(info.gamma, info.k, lowFrequencies + 1);
       const rows = [
         ['Γ dominance', `${fixed(info.gammaDominance)} (min |Γᵢᵢ| / Σⱼ≠ᵢ |Γᵢⱼ| over the first K+1 rows)`],
-        ['flipped faces', `${metrics.flippedFaces} (result against the source)`],
+        ['flipped faces', `${metrics.flippedFaces} (result against the source)${metrics.collapsedFaces ? `; ${metrics.collapsedFaces} collapsed (crushed below 1/1000 of their area)` : ''}`],
         ['detail change', `${fixed(metrics.laplacianChange)} (mean change of |Laplacian coordinates| against the source)`],
         ['moved', `mean ${fixed(metrics.vertexErrorMean)}, max ${fixed(metrics.vertexErrorMax)} × bbox diagonal from the source`],
       ];
@@ -608,13 +608,13 @@ export const panel = {
       }
       const repair = parts ? parts.flipRepair : info.flipRepair;
       if (repair?.tried) {
-        rows.push(['flip repair', `${repair.flippedBefore} flipped face${repair.flippedBefore === 1 ? '' : 's'} solved again around them: ${repair.kept ? `kept (${repair.movedVertices} vertices moved)` : 'not kept (no fewer folds)'} (${fixed(repair.ms / 1000)} s)`]);
+        rows.push(['flip repair', `${repair.flippedBefore} flipped face${repair.flippedBefore === 1 ? '' : 's'}${repair.collapsedBefore ? ` and ${repair.collapsedBefore} collapsed` : ''} solved again around them: ${repair.kept ? `kept (${repair.movedVertices} vertices moved)` : 'not kept (no fewer folds)'} (${fixed(repair.ms / 1000)} s)`]);
       }
       if (parts) {
         const kept = keptParts(parts.parts).length;
         rows.push(['parts', `${kept} of ${parts.parts.length} kept (level 1 ${fixed(parts.ms.level1 / 1000)} s, parts ${fixed(parts.ms.parts / 1000)} s)`]);
         const f = parts.folds;
-        rows.push(['self-intersections', `result ${f.result}, level 1 ${f.level1} (reference ${f.reference} + source ${f.source}); flipped faces ${f.flips} (level 1 ${f.flipsLevel1})`]);
+        rows.push(['self-intersections', `result ${f.result}, level 1 ${f.level1} (reference ${f.reference} + source ${f.source}); flipped faces ${f.flips} (level 1 ${f.flipsLevel1})${f.collapsed || f.collapsedLevel1 ? `; collapsed faces ${f.collapsed} (level 1 ${f.collapsedLevel1})` : ''}`]);
       }
       const list = $('tr-metrics');
       list.replaceChildren();

@@ -9,9 +9,10 @@
 //   buffers {cagePositions?, cageIndices?}: the user's closed cage around the source (default automatic)
 //   → buffers {positions: Float32Array (welded #V·3 of the source), cagePositions, cageIndices}
 //     info {gammaDominance, iterations, converged, couplingIterations, ms, k, gamma: number[],
-//       foldRetry {tried, kept, resolution, firstFlips, firstSelfIntersections,
+//       foldRetry {tried, kept, resolution, firstFlips, firstCollapsed, firstSelfIntersections,
 //       inputSelfIntersections, ms} (the first result folded: the cage was built on a finer grid),
-//       flipRepair {tried, kept, flippedBefore, movedVertices, ms} (the result still flipped faces:
+//       flipRepair {tried, kept, flippedBefore, collapsedBefore, movedVertices, ms} (the result still
+//       flipped or collapsed faces:
 //       their neighbourhood was solved again: transfer/flip_repair.h)}
 //   Progress messages carry the core's stages (eigenbasis, coupled bases, cage: …,
 //   mean-value coordinates, optimisation); returning false from ctx.progress cancels.
@@ -30,13 +31,13 @@
 //     fixedCageVertices (its transfer ran in the level-1 cage, this many cage vertices held),
 //     seamDihedralMean,
 //     seamDihedralMax, ms}] (transfer order, depth first), folds {reference, source, level1,
-//     result, flipsLevel1, flips}, foldRetry and flipRepair (as transfer's, for the whole
+//     result, flipsLevel1, flips, collapsedLevel1, collapsed}, foldRetry and flipRepair (as transfer's, for the whole
 //     two-level run),
 //     ms {level1, parts, total}}
 // compare: options {slotA = 'main', slotB = 'reference'} (same vertex order); buffers
 //   {positionsA?: welded #V·3} compares those positions (e.g. a transfer result) instead of slotA's
 //   → info {vertexErrorMean, vertexErrorMax, laplacianChange, edgeDistortionMean,
-//           edgeDistortionMax, flippedFaces}
+//           edgeDistortionMax, flippedFaces, collapsedFaces}
 // suggestLandmarks: options {referenceSlot = 'reference', sourceSlot = 'main', count = 8,
 //   sameConnectivity?: the meshes share vertex order (then a reference extremity pairs with the
 //   same vertex)} → info {pairs: [[r, s, cost]] (welded), reference / source: {centre, radius,
