@@ -747,7 +747,7 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     if (!fin.status.ok()) return skip(Status::error(fin.status.code, "gluing: " + fin.status.message));
     if (!fin.V.allFinite()) return skip(Status::error(StatusCode::NumericalError, "gluing produced non-finite positions"));
     // Quality gate: keep the part only if it brings the level's landmark pairs closer to the
-    // reference (after a similarity fit), adds no self-intersection and no flipped face, and
+    // reference (after a similarity fit), adds no self-intersection and no flipped or collapsed face, and
     // leaves no seam.
     // "flips" here: flipped or collapsed faces (metrics/transfer_metrics.h).
     const TransferMetrics glued = transfer_metrics(fin.V, source.V, source.F);
