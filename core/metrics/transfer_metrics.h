@@ -33,6 +33,7 @@ struct TransferMetrics {
   double edge_distortion_max = 0;
   int flipped_faces = 0;
   int collapsed_faces = 0;
+  int faulty_faces() const { return flipped_faces + collapsed_faces; }  // what the flip repair removes
 };
 
 TransferMetrics transfer_metrics(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXi& F);

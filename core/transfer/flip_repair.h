@@ -43,6 +43,8 @@ struct FlipRepairResult {
   int flipped_after = 0;    // ... of V
   int collapsed_before = 0; // collapsed faces (metrics/transfer_metrics.h) of the input, not flipped
   int collapsed_after = 0;  // ... of V
+  int faulty_before() const { return flipped_before + collapsed_before; }
+  int faulty_after() const { return flipped_after + collapsed_after; }
   int rounds = 0;           // rounds run
   int detail_rounds = 0;    // rounds kept with the rest shape's detail (the others: membrane)
   int moved_vertices = 0;   // vertices whose positions changed

@@ -533,7 +533,7 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     int done = 0, total = 0;  // parts run / in the set (progress)
   };
   int si_current = out.folds_level1.self_intersections_result;
-  int flips_current = out.folds_level1.flipped_faces + out.folds_level1.collapsed_faces;  // faulty faces
+  int flips_current = out.folds_level1.faulty_faces();
   const std::vector<LandmarkPair>& level_pairs = out.level1.landmarks;
   Eigen::MatrixXd lm_ref(level_pairs.size(), 3);
   for (size_t k = 0; k < level_pairs.size(); ++k)
@@ -641,8 +641,7 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     Eigen::MatrixXd T;
     Eigen::MatrixXi Fc;
     butterfly_coarsen(t.V, Ssub.F, levels, static_cast<int>(S.V.rows()), &T, &Fc);
-    const TransferMetrics part_metrics = transfer_metrics(T, S.V, S.F);
-    rep.transfer_flips = part_metrics.flipped_faces + part_metrics.collapsed_faces;
+    rep.transfer_flips = transfer_metrics(T, S.V, S.F).faulty_faces();
     // Step 4: registration, rotation about the boundary centroid, then the boundary centroid onto
     // the level-1 one. By the paper's local frames; or rigidly (the level-1 shape turned onto the
     // part's landmarks) when the transfer folded faces.
@@ -750,16 +749,15 @@ PartTransferResult level_and_parts(const Mesh& reference, const Mesh& source, co
     // reference (after a similarity fit), adds no self-intersection and no flipped or collapsed face, and
     // leaves no seam.
     // "flips" here: flipped or collapsed faces (metrics/transfer_metrics.h).
-    const TransferMetrics glued = transfer_metrics(fin.V, source.V, source.F);
-    int flips_after = glued.flipped_faces + glued.collapsed_faces;
+    int flips_after = transfer_metrics(fin.V, source.V, source.F).faulty_faces();
     if (flips_after > run.flips && opt.transfer.flip_repair_rings > 0) {
       // The glued part folds faces (at its seam, usually): the flip repair first, then the gate.
       FlipRepairOptions fo;
       fo.rings = opt.transfer.flip_repair_rings;
       FlipRepairResult fr = repair_flips(source, fin.V, fo);
-      if (fr.status.ok() && fr.flipped_after + fr.collapsed_after < flips_after) {
-        rep.flips_repaired = flips_after - fr.flipped_after - fr.collapsed_after;
-        flips_after = fr.flipped_after + fr.collapsed_after;
+      if (fr.status.ok() && fr.faulty_after() < flips_after) {
+        rep.flips_repaired = flips_after - fr.faulty_after();
+        flips_after = fr.faulty_after();
         fin.V = std::move(fr.V);
       }
     }

@@ -87,7 +87,7 @@ FoldReport fold_report(const Mesh& reference, const Mesh& source, const Eigen::M
 
 Status repair_transfer_flips(const Mesh& source, int rings, const Progress& progress, Eigen::MatrixXd* result,
                              FoldReport* folds, FlipRepair* record) {
-  if (rings <= 0 || folds->flipped_faces + folds->collapsed_faces == 0) return Status{};
+  if (rings <= 0 || folds->faulty_faces() == 0) return Status{};
   FlipRepairOptions o;
   o.rings = rings;
   FlipRepairResult r = repair_flips(source, *result, o, progress);
@@ -97,7 +97,7 @@ Status repair_transfer_flips(const Mesh& source, int rings, const Progress& prog
   record->rounds = r.rounds;
   record->ms = r.ms;
   if (r.status.code == StatusCode::Cancelled) return r.status;
-  if (!r.status.ok() || r.flipped_after + r.collapsed_after >= r.flipped_before + r.collapsed_before) return Status{};
+  if (!r.status.ok() || r.faulty_after() >= r.faulty_before()) return Status{};
   const FoldReport repaired = fold_report(*folds, source, r.V);
   if (repaired.violations() < folds->violations()) {
     record->kept = true;

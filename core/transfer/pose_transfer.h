@@ -110,13 +110,14 @@ struct FoldReport {
   int self_intersections_result = 0;     // ... of the result
   int flipped_faces = 0;                 // result's local fold-overs against the source
   int collapsed_faces = 0;               // result's faces crushed below 1e-3 of their area (not flipped)
+  int faulty_faces() const { return flipped_faces + collapsed_faces; }
   bool new_folds() const {               // more self-intersections than the inputs together
     return self_intersections_result > self_intersections_reference + self_intersections_source;
   }
   // Flipped and collapsed faces plus the self-intersecting pairs beyond the inputs' count (0 = no
   // fold).
   int violations() const {
-    return flipped_faces + collapsed_faces +
+    return faulty_faces() +
            std::max(0, self_intersections_result - self_intersections_reference - self_intersections_source);
   }
 };
