@@ -295,17 +295,18 @@ TEST(JointFitting, SelfFitEveryCharacter) {
 }
 
 TEST(JointFitting, StaticMeshesAgainstHandPlacedJoints) {
-  // Issue 14 asks for 4 % of the height; measured 4.6 % (woman: her thighs touch, so her curve
-  // skeleton forks at the knees; the split up to the crotch (step 4b) took her from 5.9 %, the
-  // pelvis and hips still land 0.08–0.10 low) and 8.7 % (wolf: the tail). The bounds below hold
-  // what was reached, so a regression shows.
+  // Issue 14 asks for 4 % of the height. Woman: 3.5 % (her thighs touch, so her curve skeleton
+  // forks at the knees; the split up to the crotch (step 4b) took her from 5.9 % to 4.5 %, and
+  // moving the fork to the trunk's medial junction above the crotch to 3.5 %: hips 0.097 → 0.047,
+  // pelvis 0.077 → 0.017; the upper neck is still 0.09 low). Wolf: 8.4 % (the tail, a raised Fox
+  // tail against a hanging one, 0.15–0.28), not met; its bound holds what was reached.
   struct Case {
     const char* source;
     const char* target;
     const char* joints;
     double bound;
   };
-  for (const Case& c : {Case{"anim/CesiumMan/CesiumMan.glb", "anim/human_woman.ply", "joints/human_woman_joints.json", 0.05},
+  for (const Case& c : {Case{"anim/CesiumMan/CesiumMan.glb", "anim/human_woman.ply", "joints/human_woman_joints.json", 0.04},
                         Case{"anim/Fox/glTF-Binary/Fox.glb", "anim/wolf0.ply", "joints/wolf0_joints.json", 0.095}}) {
     const JfCharacter s = jf_character(c.source);
     const mm::io::LoadResult t = mm::io::load_asset(mm::test::data_path(c.target));
@@ -331,7 +332,7 @@ TEST(JointFitting, StaticMeshesAgainstHandPlacedJoints) {
 // (the two static meshes above), five markers at the hand-placed positions of the joints a person
 // would click (pelvis/groin, wrists, ankles; the wolf's hip, head, tail tip and hands). The error is
 // reported over every joint and over the joints that were not pinned (those are the fit's).
-// Measured: woman 2.7 % (3.7 % over the 14 unpinned), within the bound; wolf 7.1 % (9.2 %
+// Measured: woman 2.5 % (3.4 % over the 14 unpinned), within the bound; wolf 6.8 % (8.8 %
 // unpinned), not: its limb roots sit where the curve skeleton branches off the spine, 12 units
 // above the hand-placed ones, and markers only drag neighbours (marker_reach) instead of
 // refitting the chain. The wolf's bound holds what was reached, so a regression shows.
@@ -415,10 +416,11 @@ TEST(JointFitting, BipedOnQuadrupedIsRefused) {
 
 // A blocky, many-part source (KayKit: 24 curve-skeleton limb ends for 5 limbs) on a static human:
 // the curve skeletons alone (Voxel) refuse it as a mismatch and name the other way; the source's
-// own bones fit, and the default (Auto) falls back to them. Measured 6.9 % of the height from the
+// own bones fit, and the default (Auto) falls back to them. Measured 5.8 % of the height from the
 // hand-placed KayKit joints (13.2 % before the limb ends' back points stopped at half the limb,
-// 10.2 % before her touching legs were split up to the crotch): arms and head within 4.1 %; the
-// hips and upper legs still land ~0.2 low (the Knight's chibi legs are a quarter of its height).
+// 10.2 % before her touching legs were split up to the crotch, 7.2 % before her fork moved to the
+// trunk's junction above the crotch); the upper legs still land ~0.17 off (the Knight's chibi legs
+// are a quarter of its height).
 // Far from issue 14's 4 %, so the bound holds what was reached. The bones mode still refuses a
 // biped on a quadruped.
 TEST(JointFitting, BlockySourceOnAStaticHumanFitsItsOwnBones) {
@@ -450,7 +452,7 @@ TEST(JointFitting, BlockySourceOnAStaticHumanFitsItsOwnBones) {
   const JfError e = jf_joint_error(r.joints, truth.joints, jf_extent(woman.asset.V_raw, r.target_up % 3));
   jf_print("Knight bones in human_woman vs hand-placed", e, r);
   EXPECT_EQ(e.count, truth.joints.size());
-  EXPECT_LE(e.mean, 0.075);
+  EXPECT_LE(e.mean, 0.065);
   // Each hand goes to her hand (not to the bump at her left shoulder).
   const double height = jf_extent(woman.asset.V_raw, r.target_up % 3);
   for (const char* name : {"wrist.l", "wrist.r"}) {
@@ -614,10 +616,9 @@ TEST(JointFittingRetarget, SkeletonPriorOnlyForTheSourcesRigFamily) {
 }
 
 TEST(JointFittingRetarget, StaticTargetsBoneLengthsNoWorseThanHandPlaced) {
-  // Issue 14 asks for 4 % of the height; measured 4.6 % (woman: her thighs touch, so her curve
-  // skeleton forks at the knees; the split up to the crotch (step 4b) took her from 5.9 %, the
-  // pelvis and hips still land 0.08–0.10 low) and 8.7 % (wolf: the tail). The bounds below hold
-  // what was reached, so a regression shows.
+  // The retargeted clip's bone-length error with automatic joints against hand-placed ones.
+  // Measured (twenty-eighth session): woman 0.00465 vs 0.00434 (7 % above), wolf 0.0104 vs 0.0095
+  // (10 % above): close, not "no worse". The bound allows 5 % plus 1e-3 of the height.
   struct Case {
     const char* source;
     const char* target;

@@ -315,11 +315,13 @@ std::string jf_join(const std::vector<std::string>& v, size_t limit = 10) {
 // fitted 0.1–0.3 of the height low. Seen across the trunk just above such a fork, the solid is
 // two thighs side by side: thinner front to back between them than through each. Walking up the
 // trunk while that groove holds (centre thickness < groove_ratio × the thinner side, the sides at
-// the legs' half separation just below the fork) finds the crotch; the fork is moved there (not
-// past another branch) and each leg continued straight up to it, side by side at that separation.
-// feet/head: target leaf nodes. Returns the old → new node index map, or empty when nothing changed.
+// the legs' half separation just below the fork) finds the crotch; the fork is moved to the trunk's
+// medial junction above it (not past another branch) and each leg continued up to it, side by side
+// at that separation to the crotch and converging above it. feet/head: leaf nodes; vertical: the
+// character's up axis in the skeleton's coordinates. Returns the old → new node index map, or
+// empty when nothing changed.
 std::vector<int> jf_split_touching_legs(CurveSkeleton* T, const JfTree& tt, const std::array<int, 2>& feet, int head,
-                                        double groove_ratio) {
+                                        const Eigen::Vector3d& vertical, double groove_ratio) {
   const int fork_t = tt.median(feet[0], feet[1], head);
   const auto adj = T->adjacency();
   if (adj[fork_t].size() != 3) return {};
@@ -361,10 +363,29 @@ std::vector<int> jf_split_touching_legs(CurveSkeleton* T, const JfTree& tt, cons
     ++k;
   }
   if (k == 0 || k + 1 >= int(trunk.nodes.size())) return {};
-  // Rebuild: drop trunk nodes 0..k−1, add one chain per leg from its node below to trunk node k.
+  // The fork goes where a pair of separate legs has it: the medial axis of a Y branches at the
+  // centre of the largest ball that touches the crotch, about one trunk radius above it. The
+  // crotch is the groove's end (node k) when the trunk below it stays solid deeper than its radius
+  // (thighs that touch), else the top of the gap below (the groove was a buttocks' cleft above
+  // legs that are apart: CesiumMan, gap 0.056 of his height). The junction is the first trunk node
+  // above the crotch whose radius no longer exceeds its distance from it, not past another branch.
+  // Measured: CesiumMan's junction stays at his groove's end, 0.409 of his height (his hip joints
+  // 0.408); human_woman's moves from her crotch, 0.431, to 0.510 (her hand-placed hips 0.516).
+  const Eigen::Vector3d crotch_top = tt.pos(trunk.nodes[k]);
+  const double r_crotch = T->radius[trunk.nodes[k]];
+  double gap = 0;
+  while (gap <= 1.5 * r_crotch && solid.contains(crotch_top - gap * vertical)) gap += step;
+  if (gap > 1.5 * r_crotch) gap = 0;
+  int junction = k;
+  while (junction + 1 < int(trunk.nodes.size()) && adj[trunk.nodes[junction]].size() == 2 &&
+         gap + trunk.arc[junction] - trunk.arc[k] < T->radius[trunk.nodes[junction]])
+    ++junction;
+  if (junction + 1 >= int(trunk.nodes.size())) junction = k;
+  // Rebuild: drop trunk nodes 0..junction−1, add one chain per leg from its node below to the
+  // junction: side by side at the legs' half separation up to the crotch, converging above it.
   const int n = T->size();
   std::vector<uint8_t> drop(n, 0);
-  for (int i = 0; i < k; ++i) drop[trunk.nodes[i]] = 1;
+  for (int i = 0; i < junction; ++i) drop[trunk.nodes[i]] = 1;
   std::vector<int> remap(n, -1);
   std::vector<Eigen::Vector3d> pos;
   std::vector<double> radius;
@@ -377,18 +398,19 @@ std::vector<int> jf_split_touching_legs(CurveSkeleton* T, const JfTree& tt, cons
   for (int i = 0; i < 2; ++i) {
     int prev = remap[below[i]];
     const double sign = i == 0 ? 1.0 : -1.0;
-    for (int j = 0; j < k; ++j) {
+    for (int j = 0; j < junction; ++j) {
       const int id = int(pos.size());
-      pos.push_back(tt.pos(trunk.nodes[j]) + sign * half);
+      const double above = j <= k ? 0.0 : (trunk.arc[j] - trunk.arc[k]) / (trunk.arc[junction] - trunk.arc[k]);
+      pos.push_back(tt.pos(trunk.nodes[j]) + sign * (1 - above) * half);
       radius.push_back(T->radius[below[i]]);
       nb.emplace_back();
       link(prev, id);
       prev = id;
     }
-    link(prev, remap[trunk.nodes[k]]);
+    link(prev, remap[trunk.nodes[junction]]);
   }
   const int m = int(pos.size());
-  const int root = remap[T->root] >= 0 ? remap[T->root] : remap[trunk.nodes[k]];
+  const int root = remap[T->root] >= 0 ? remap[T->root] : remap[trunk.nodes[junction]];
   std::vector<int> parent(m, -2);
   parent[root] = -1;
   std::vector<int> queue = {root};
@@ -699,9 +721,9 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     if (feet.size() == 2 && top >= 0) {
       const std::pair<int, int> head = match.pairs[top];
       const std::vector<int> remap_t = jf_split_touching_legs(&r.target_skeleton, tt, {feet[0].second, feet[1].second},
-                                                              head.second, opt.touching_legs_groove);
+                                                              head.second, ut, opt.touching_legs_groove);
       const std::vector<int> remap_s =
-          source_is_curve ? jf_split_touching_legs(&r.source_skeleton, st, {feet[0].first, feet[1].first}, head.first,
+          source_is_curve ? jf_split_touching_legs(&r.source_skeleton, st, {feet[0].first, feet[1].first}, head.first, us,
                                                    opt.touching_legs_groove)
                           : std::vector<int>{};
       if (!remap_t.empty()) {
