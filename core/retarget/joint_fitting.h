@@ -70,6 +70,7 @@ struct JointFitOptions {
   double back_length = 0.25;      // back point of a limb end: this × height up its path (pose-robust matching),
   double back_limb_fraction = 0.5; // but at most this × the limb's length to its first branch point
   double ground_band = 0.12;      // limb ends below this × height count as standing on the ground
+  double min_up_extent = 0.3;     // a detected up axis spans at least this × the longest extent
   double inside_tolerance = 0.01; // a joint within this × bbox diagonal outside the surface counts as inside
   double touching_legs_groove = 0.95;// biped target: trunk nodes above the leg fork whose front-to-back thickness
                                    // between the legs is below this × through each leg are thighs that touch;
