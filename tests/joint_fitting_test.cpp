@@ -334,7 +334,7 @@ TEST(JointFitting, StaticMeshesAgainstHandPlacedJoints) {
 // used to be detected as −z (three limb ends near her back, an axis 0.18 of her height deep) and
 // the fit was refused; a detected up axis must now span ≥ 0.3 of the longest extent. At 88 cells
 // her skeleton gives a broken fit (21 % of the height): it is not refused, but its bones disagree
-// with the source's by 56 % (good fits ≤ 37 %) and the result says so.
+// with the source's by 56 % (good fits at other grids 37–42 %) and the result says so.
 TEST(JointFitting, OtherResolutionsFindTheUpAxisAndFlagBrokenFits) {
   const JfCharacter s = jf_character("anim/CesiumMan/CesiumMan.glb");
   const mm::io::LoadResult t = mm::io::load_asset(mm::test::data_path("anim/human_woman.ply"));

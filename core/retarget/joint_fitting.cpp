@@ -919,8 +919,9 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     }
     const double a = opt.skeleton_prior_agreement, rel = len > 0 ? dev / len : 0;
     r.skeleton_agreement = rel;
-    // Fits of one kind of character measure r 0.11–0.37 (above); the broken fits seen at unlucky
-    // grid resolutions 0.48–0.56 (human_woman at 88 cells: 0.556, mean joint error 21 %).
+    // Fits of one kind of character measure r 0.11–0.42 (above; human_woman at the grids where her
+    // fit is good, 3.5–4.2 %: 0.37–0.42); her broken fits at unlucky grid resolutions 0.53–0.62
+    // (88 cells: 0.556, mean joint error 21 %).
     if (rel > 0.45) {
       char note[240];
       std::snprintf(note, sizeof note,
