@@ -676,9 +676,22 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
   std::map<int, int> matched_s;  // source leaf node → index in match.pairs
   for (size_t k = 0; k < match.pairs.size(); ++k) matched_s[match.pairs[k].first] = int(k);
   if (opt.check_topology) {
-    std::vector<std::string> lost;
+    std::vector<std::string> lost, pinned_lost;
     // An unmatched end carrying joints is lost unless it is a sub-branch of a matched limb
     // (another finger of a matched hand): path length to a matched end < back_length × height.
+    // A lost limb with a joint pinned by a marker, or within marker_reach bones of one, is not
+    // refused (the refusal asks for markers): its joints are placed on the matched limbs and
+    // follow the markers (step 6 moves joints up to marker_reach bones from a marker).
+    std::vector<int> hops(source_joints.size(), -1), queue;
+    for (const JointMarker& m : markers)
+      if (const int k = source_joints.find(m.name); k >= 0 && hops[k] < 0) hops[k] = 0, queue.push_back(k);
+    const bool has_tree = static_cast<int>(source_joints.parent.size()) == source_joints.size();
+    for (size_t h = 0; h < queue.size() && has_tree; ++h) {
+      const int k = queue[h];
+      if (hops[k] >= opt.marker_reach) continue;
+      for (int n = 0; n < source_joints.size(); ++n)
+        if ((source_joints.parent[n] == k || source_joints.parent[k] == n) && hops[n] < 0) hops[n] = hops[k] + 1, queue.push_back(n);
+    }
     for (const auto& [leaf, names] : joints_on_leaf) {
       if (matched_s.count(leaf) || names.size() < 2) continue;
       double nearest = std::numeric_limits<double>::infinity();
@@ -687,8 +700,16 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
         const double d = (st.pos(leaf) - st.pos(l)).norm() + (st.pos(pr.first) - st.pos(l)).norm();
         nearest = std::min(nearest, d);
       }
-      if (nearest > opt.back_length * fs.H) lost.push_back(names.back());
+      if (nearest <= opt.back_length * fs.H) continue;
+      const bool pinned = std::any_of(names.begin(), names.end(), [&](const std::string& n) {
+        const int k = source_joints.find(n);
+        return k >= 0 && hops[k] >= 0;
+      });
+      (pinned ? pinned_lost : lost).push_back(names.back());
     }
+    if (lost.empty() && !pinned_lost.empty())
+      r.warnings.push_back("no limb of the target matches the source's chain ending at " + jf_join(pinned_lost) +
+                           ": its joints were placed from your markers; check them");
     const std::string counts = "the source has " + std::to_string(s_leaves.size()) + " limb ends (" +
                                std::to_string(r.source_ground) + " on the ground), the target " +
                                std::to_string(t_leaves.size()) + " (" + std::to_string(r.target_ground) +
