@@ -499,4 +499,58 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     await shot(page, 'retarget-17-context-graph');
     check(pageErrors.length === 0, `uncaught page errors: ${pageErrors.join(' | ')}`);
   });
+  it('retarget: a refused automatic fit (RobotExpressive\'s skeleton in CesiumMan) goes on with pins loaded from a markers file; the joints equal the CLI\'s (joints --markers)', async ({ page, browser, pageErrors }) => {
+    const cesium = path.join(repoDir, 'data/anim/CesiumMan/CesiumMan.glb');
+    const robot = path.join(repoDir, 'data/anim/RobotExpressive/RobotExpressive.glb');
+    await openJob(page);
+    await chooseCharacter(page, 'robot');
+    await page.setInputFiles('#rt-target-file', cesium);
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.target?.id === 'file', null, { timeout: 60000 });
+    await waitIdle(page);
+    await page.selectOption('#rt-joints-from', 'auto');
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.fit.status === 'error', null, { timeout: 120000 });
+    // The core's refusal names the limb and asks for markers; with no joints to drag, the page
+    // offers pins from a file.
+    const refusal = await page.textContent('#rt-target-info');
+    check(/pin those joints with markers/.test(refusal) && /Load pins/.test(refusal), `the refusal: "${refusal}"`);
+    check(await page.isVisible('#rt-pins-load'), 'no Load pins… after the refused fit');
+    check(await page.isDisabled('#rt-edit-joints'), 'Edit joints is offered with no joints to edit');
+    await shot(page, 'retarget-17-fit-refused');
+    await page.evaluate(() => { window.__meshmorph.state.error = null; });
+    // Markers at CesiumMan's own knees, elbows and neck (its self fit by the CLI: its skin's
+    // joints), under the robot's joint names — the kind of markers issue 14 names.
+    const selfFile = path.join(shotDir, 'cesiumman-self-joints.json');
+    cli(['joints', cesium, '--like', cesium, '--out', selfFile], 'joints (CesiumMan self fit)');
+    const own = JSON.parse(fs.readFileSync(selfFile, 'utf8'));
+    const pick = { 'LowerLeg.L': 'leg_joint_L_2', 'LowerLeg.R': 'leg_joint_R_2', 'LowerArm.L': 'Skeleton_arm_joint_L__3_', 'LowerArm.R': 'Skeleton_arm_joint_R__2_', Neck: 'Skeleton_neck_joint_1' };
+    const markersFile = path.join(shotDir, 'robot-in-cesiumman-markers.json');
+    fs.writeFileSync(markersFile, JSON.stringify(Object.fromEntries(Object.entries(pick).map(([r, c]) => [r, own[c]]))));
+    await page.setInputFiles('#rt-pins-file', markersFile);
+    await page.waitForFunction(() => window.__meshmorph.state.retarget.fit.status === 'done' && window.__meshmorph.state.retarget.joints > 0, null, { timeout: 120000 })
+      .catch(async (e) => {
+        const st = await rtState(page);
+        throw new Error(`${e.message}: pins ${JSON.stringify(st.pins)}, fit ${JSON.stringify(st.fit)}, info "${await page.textContent('#rt-target-info')}"`);
+      });
+    const st = await rtState(page);
+    check(Object.keys(st.pins).length === 5, `pins after loading: ${JSON.stringify(Object.keys(st.pins))}`);
+    const info = await page.textContent('#rt-target-info');
+    check(/placed from your markers/.test(info), `the fit's warning is not shown: "${info}"`);
+    check(!(await page.isVisible('#error')), 'the refusal\'s banner is still shown after the pins made the fit');
+    const joints = await page.evaluate(() => window.__meshmorph.hooks.retargetJoints());
+    const cliFile = path.join(shotDir, 'robot-in-cesiumman-joints.json');
+    cli(['joints', cesium, '--like', robot, '--markers', markersFile, '--out', cliFile], 'joints --markers');
+    const byCli = JSON.parse(fs.readFileSync(cliFile, 'utf8'));
+    check(joints.names.length === Object.keys(byCli).length && joints.names.every((n) => n in byCli), `page joints ${joints.names.length}, CLI ${Object.keys(byCli).length}`);
+    const h = heightOf(joints.positions.flat());
+    const worst = Math.max(...joints.names.map((n, j) => Math.hypot(...joints.positions[j].map((v, c) => v - byCli[n][c]))));
+    record(browser, 'retarget RobotExpressive → CesiumMan, 5 pins loaded after the refusal: page vs CLI joints (max / height)', (worst / h).toExponential(2));
+    check(worst / h < 1e-5, `the page's joints differ from the CLI's by ${worst / h} of the height`);
+    for (const [name, p] of Object.entries(st.pins)) {
+      const j = joints.names.indexOf(name);
+      check(j >= 0 && Math.hypot(...joints.positions[j].map((v, c) => v - p[c])) < 1e-6 * h, `${name} is not held at its pin`);
+    }
+    await nextFrame(page);
+    await shot(page, 'retarget-18-pins-loaded');
+    check(pageErrors.length === 0, `uncaught page errors: ${pageErrors.join(' | ')}`);
+  });
 }

@@ -97,6 +97,9 @@ test('joints: file round trip, errors, bones through missing ancestors, followin
   assert.throws(() => readJointsFile([1, 2]), /expected an object/);
   assert.throws(() => readJointsFile({ a: [0, 0] }, 'j.json'), /j.json: joint "a" must be/);
   assert.throws(() => readJointsFile({ a: [0, 0, 0] }), /at least 2/);
+  // Pins (the CLI's markers file): one joint is enough, none is not.
+  assert.deepEqual(readJointsFile({ a: [0, 1, 2] }, 'pins.json', { min: 1 }), [{ name: 'a', position: [0, 1, 2] }]);
+  assert.throws(() => readJointsFile({}, 'pins.json', { min: 1 }), /pins.json: needs at least 1 joint \(found 0\)/);
   // root → hips → spine → chest; "spine" is not a joint here: chest's bone goes to hips.
   const parents = { hips: 'root', spine: 'hips', chest: 'spine', head: 'chest', root: null };
   assert.deepEqual(bonesOf(['hips', 'chest', 'head'], (n) => parents[n] ?? null), [[1, 0], [2, 1]]);

@@ -10,7 +10,8 @@
 import { MeshMorphError } from './errors.js';
 
 // A joints file (parsed JSON) → [{name, position: [x, y, z]}] in the file's order.
-export function readJointsFile(json, fileName = 'joints file') {
+// min: the fewest joints the file may hold (a joints file 2; pins, the CLI's --markers file, 1).
+export function readJointsFile(json, fileName = 'joints file', { min = 2 } = {}) {
   if (!json || typeof json !== 'object' || Array.isArray(json)) {
     throw new MeshMorphError('ParseError', `${fileName}: expected an object {"joint name": [x, y, z], ...}`);
   }
@@ -21,7 +22,7 @@ export function readJointsFile(json, fileName = 'joints file') {
     }
     out.push({ name, position: [...p] });
   }
-  if (out.length < 2) throw new MeshMorphError('ParseError', `${fileName}: needs at least 2 joints (found ${out.length})`);
+  if (out.length < min) throw new MeshMorphError('ParseError', `${fileName}: needs at least ${min} joint${min === 1 ? '' : 's'} (found ${out.length})`);
   return out;
 }
 

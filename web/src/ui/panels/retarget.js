@@ -98,6 +98,7 @@ const markup = `
     <span id="rt-pins-info" class="hint"></span>
     <button id="rt-pins-clear" type="button" title="Forget every pinned joint and fit again">Clear pins</button>
     <button id="rt-pins-save" type="button" title="The pinned joints as the CLI's markers file (meshmorph retarget --target-joints auto --markers M.json)">Download pins JSON</button>
+    <label class="button file" id="rt-pins-load" title="Pins from a file, the CLI's markers file {&quot;joint name&quot;: [x, y, z]}: the automatic fit keeps these joints there (also when it refused the fit without them)">Load pins…<input type="file" id="rt-pins-file" accept=".json,application/json" /></label>
   </div>
   <div class="row">
     <label title="Draw the target see-through with its joints (spheres) and bones (lines)"><input type="checkbox" id="rt-skeleton" checked /> Joints and bones</label>
@@ -597,7 +598,8 @@ export const panel = {
         retarget.fit = { ...retarget.fit, status: 'error', error: e.message };
         runText('');
         if (!quiet) app.showError(e);
-        $('rt-target-info').textContent = `${target.name}: the automatic joints failed (${e.message}). Choose "from a joints file", or pick a clip of another character.`;
+        $('rt-target-info').textContent = `${target.name}: the automatic joints failed (${e.message}). Choose "from a joints file", load pins for the joints it names (Load pins…), or pick a clip of another character.`;
+        if (!quiet) showPins();
         return null;
       } finally {
         if (fitRequest === req) fitRequest = null;
@@ -612,9 +614,16 @@ export const panel = {
     function showPins() {
       const names = Object.keys(retarget.pins);
       const draggable = joints && retarget.jointsFrom !== 'skin';
-      $('rt-pins-row').hidden = !draggable;
+      // A refused automatic fit has no joints to drag: pins come from a file then (the core's
+      // refusal names the joints to pin).
+      const refused = !joints && retarget.jointsFrom === 'auto' && retarget.fit.status === 'error';
+      $('rt-pins-row').hidden = !draggable && !refused;
+      $('rt-pins-load').hidden = retarget.jointsFrom !== 'auto';
+      $('rt-edit-joints').disabled = !draggable;
       if (!draggable && retarget.editingJoints) setEditingJoints(false);
-      $('rt-pins-info').textContent = !retarget.editingJoints
+      $('rt-pins-info').textContent = refused
+        ? 'No joints to drag: load pins (the CLI\'s markers file) for the joints the message names.'
+        : !retarget.editingJoints
         ? 'A joint in the wrong place? Edit joints, then drag it.'
         : retarget.jointsFrom === 'auto'
           ? (names.length ? `Pinned: ${names.join(', ')}. Drag a joint to pin it too.` : 'Drag a joint: it stays where you drop it and the others fit around it.')
@@ -682,6 +691,26 @@ export const panel = {
       retarget.pins = {};
       if (retarget.jointsFrom === 'auto') chooseJoints();
       else showPins();
+    });
+    $('rt-pins-file').addEventListener('change', async () => {
+      const file = $('rt-pins-file').files[0];
+      $('rt-pins-file').value = '';
+      if (!file || retarget.jointsFrom !== 'auto') return;
+      try {
+        let parsed;
+        try {
+          parsed = JSON.parse(await file.text());
+        } catch (e) {
+          throw new MeshMorphError('ParseError', `${file.name}: ${e.message}`);
+        }
+        retarget.pins = Object.fromEntries(readJointsFile(parsed, file.name, { min: 1 }).map((j) => [j.name, j.position]));
+      } catch (e) {
+        app.showError(e);
+        return;
+      }
+      app.clearError(); // the refusal the pins answer
+      showPins();
+      chooseJoints();
     });
     $('rt-pins-save').addEventListener('click', () => {
       download(new TextEncoder().encode(`${JSON.stringify(retarget.pins, null, 1)}\n`), `${stem(target.name)}_pins.json`, 'application/json');
