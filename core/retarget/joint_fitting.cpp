@@ -304,6 +304,26 @@ CurveSkeleton jf_bone_skeleton(const CurveSkeleton& voxel, const JointSet& J, co
   return out;
 }
 
+// Bones between joints (parent[i] = i's parent, −1 for a root) as neighbour lists, and the hops
+// from the joints `from` along them, at most `reach`, never through a `blocked` joint (another
+// marker's: step 6 and the topology check's markers reach the same joints). −1 = not reached.
+std::vector<std::vector<int>> jf_bone_adjacency(const std::vector<int>& parent) {
+  std::vector<std::vector<int>> adj(parent.size());
+  for (size_t i = 0; i < parent.size(); ++i)
+    if (parent[i] >= 0) adj[i].push_back(parent[i]), adj[parent[i]].push_back(int(i));
+  return adj;
+}
+std::vector<int> jf_hops(const std::vector<std::vector<int>>& adj, const std::vector<int>& from, int reach,
+                         const std::vector<uint8_t>& blocked) {
+  std::vector<int> hop(adj.size(), -1);
+  std::vector<int> q = from;
+  for (int k : from) hop[k] = 0;
+  for (size_t h = 0; h < q.size(); ++h)
+    for (int nb : adj[q[h]])
+      if (hop[nb] < 0 && hop[q[h]] < reach && !blocked[nb]) hop[nb] = hop[q[h]] + 1, q.push_back(nb);
+  return hop;
+}
+
 std::string jf_join(const std::vector<std::string>& v, size_t limit = 10) {
   std::string s;
   for (size_t i = 0; i < v.size() && i < limit; ++i) s += (i ? ", " : "") + v[i];
@@ -679,19 +699,16 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     std::vector<std::string> lost, pinned_lost;
     // An unmatched end carrying joints is lost unless it is a sub-branch of a matched limb
     // (another finger of a matched hand): path length to a matched end < back_length × height.
-    // A lost limb with a joint pinned by a marker, or within marker_reach bones of one, is not
-    // refused (the refusal asks for markers): its joints are placed on the matched limbs and
-    // follow the markers (step 6 moves joints up to marker_reach bones from a marker).
-    std::vector<int> hops(source_joints.size(), -1), queue;
+    // A lost limb with a joint pinned by a marker, or within marker_reach bones of one (the joints
+    // step 6 moves, jf_hops), is not refused (the refusal asks for markers): its joints are placed
+    // on the matched limbs and follow the markers.
+    std::vector<int> marked;
+    std::vector<uint8_t> is_marked(source_joints.size(), 0);
     for (const JointMarker& m : markers)
-      if (const int k = source_joints.find(m.name); k >= 0 && hops[k] < 0) hops[k] = 0, queue.push_back(k);
+      if (const int k = source_joints.find(m.name); k >= 0 && !is_marked[k]) is_marked[k] = 1, marked.push_back(k);
     const bool has_tree = static_cast<int>(source_joints.parent.size()) == source_joints.size();
-    for (size_t h = 0; h < queue.size() && has_tree; ++h) {
-      const int k = queue[h];
-      if (hops[k] >= opt.marker_reach) continue;
-      for (int n = 0; n < source_joints.size(); ++n)
-        if ((source_joints.parent[n] == k || source_joints.parent[k] == n) && hops[n] < 0) hops[n] = hops[k] + 1, queue.push_back(n);
-    }
+    const std::vector<int> hops = jf_hops(jf_bone_adjacency(has_tree ? source_joints.parent : std::vector<int>(source_joints.size(), -1)),
+                                          marked, opt.marker_reach, is_marked);
     for (const auto& [leaf, names] : joints_on_leaf) {
       if (matched_s.count(leaf) || names.size() < 2) continue;
       double nearest = std::numeric_limits<double>::infinity();
@@ -980,7 +997,7 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
 
   // Markers: pin, and drag chain neighbours within marker_reach bones.
   if (!markers.empty()) {
-    std::vector<int> pinned(out.size(), 0);
+    std::vector<uint8_t> pinned(out.size(), 0);
     std::vector<Eigen::Vector3d> delta(out.size(), Eigen::Vector3d::Zero());
     for (const JointMarker& m : markers) {
       const int k = out.find(m.name);
@@ -997,21 +1014,14 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
       delta[k] = m.position - out.P.row(k).transpose();
     }
     // Hops between joints along the hierarchy (small sets: BFS per pinned joint).
-    std::vector<std::vector<int>> adj(out.size());
-    for (int i = 0; i < out.size(); ++i)
-      if (out.parent[i] >= 0) adj[i].push_back(out.parent[i]), adj[out.parent[i]].push_back(i);
+    const std::vector<std::vector<int>> adj = jf_bone_adjacency(out.parent);
     Eigen::MatrixXd D = Eigen::MatrixXd::Zero(out.size(), 3);
     Eigen::VectorXd W = Eigen::VectorXd::Zero(out.size());
     for (int k = 0; k < out.size(); ++k) {
       if (!pinned[k]) continue;
-      std::vector<int> hop(out.size(), -1);
-      std::vector<int> q = {k};
-      hop[k] = 0;
-      for (size_t h = 0; h < q.size(); ++h)
-        for (int nb : adj[q[h]])
-          if (hop[nb] < 0 && hop[q[h]] < opt.marker_reach && !pinned[nb]) hop[nb] = hop[q[h]] + 1, q.push_back(nb);
-      for (int i : q) {
-        if (i == k) continue;
+      const std::vector<int> hop = jf_hops(adj, {k}, opt.marker_reach, pinned);
+      for (int i = 0; i < out.size(); ++i) {
+        if (i == k || hop[i] < 0) continue;
         const double w = 1.0 - double(hop[i]) / (opt.marker_reach + 1);
         D.row(i) += w * delta[k].transpose();
         W[i] += w;

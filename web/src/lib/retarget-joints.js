@@ -26,6 +26,17 @@ export function readJointsFile(json, fileName = 'joints file', { min = 2 } = {})
   return out;
 }
 
+// The same from the file's text (a joints file or pins): malformed JSON is a ParseError naming the file.
+export function parseJointsText(text, fileName = 'joints file', options = {}) {
+  let parsed;
+  try {
+    parsed = JSON.parse(text);
+  } catch (e) {
+    throw new MeshMorphError('ParseError', `${fileName}: ${e.message}`);
+  }
+  return readJointsFile(parsed, fileName, options);
+}
+
 // The joints as the CLI's file (insertion order kept).
 export function jointsFile(joints) {
   return Object.fromEntries(joints.map((j) => [j.name, j.position.map((v) => Number(v.toPrecision(9)))]));

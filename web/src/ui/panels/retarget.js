@@ -40,7 +40,7 @@ import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
 import { clipOption, filterClips, jointsFileFor, familiesOf, librarySources, libraryTargets } from '../../lib/clip-library.js';
 import { MeshMorphError, toMeshMorphError } from '../../lib/errors.js';
 import { FrameStore, PlaybackClock } from '../../lib/frame-store.js';
-import { JointFollower, boneLengthChange, boneLengths, bonesOf, jointsFile, readJointsFile } from '../../lib/retarget-joints.js';
+import { JointFollower, boneLengthChange, boneLengths, bonesOf, jointsFile, parseJointsText } from '../../lib/retarget-joints.js';
 import { RetargetRunner } from '../../lib/retarget-runner.js';
 import { ClipPreview } from '../../view/clip-preview.js';
 import { RetargetView } from '../../view/retarget-view.js';
@@ -527,13 +527,7 @@ export const panel = {
             $('rt-target-info').textContent = `${target.name}: ${target.load.info.weldedVertices} vertices. Load its joints file (Joints file…).`;
             return refresh();
           }
-          let parsed;
-          try {
-            parsed = JSON.parse(text);
-          } catch (e) {
-            throw new MeshMorphError('ParseError', `${name}: ${e.message}`);
-          }
-          const list = readJointsFile(parsed, name);
+          const list = parseJointsText(text, name);
           const parentOf = source ? source.parentOf : () => null;
           // Bones follow the source skeleton (the file uses its names, or a map to them).
           const map = mapText ? JSON.parse(mapText) : {};
@@ -697,13 +691,7 @@ export const panel = {
       $('rt-pins-file').value = '';
       if (!file || retarget.jointsFrom !== 'auto') return;
       try {
-        let parsed;
-        try {
-          parsed = JSON.parse(await file.text());
-        } catch (e) {
-          throw new MeshMorphError('ParseError', `${file.name}: ${e.message}`);
-        }
-        retarget.pins = Object.fromEntries(readJointsFile(parsed, file.name, { min: 1 }).map((j) => [j.name, j.position]));
+        retarget.pins = Object.fromEntries(parseJointsText(await file.text(), file.name, { min: 1 }).map((j) => [j.name, j.position]));
       } catch (e) {
         app.showError(e);
         return;
