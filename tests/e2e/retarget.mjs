@@ -522,6 +522,43 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     const selfFile = path.join(shotDir, 'cesiumman-self-joints.json');
     cli(['joints', cesium, '--like', cesium, '--out', selfFile], 'joints (CesiumMan self fit)');
     const own = JSON.parse(fs.readFileSync(selfFile, 'utf8'));
+    // First by clicking: the refusal's joints come first in "Click to pin"; LowerLeg.L chosen,
+    // then a real click on CesiumMan where his left knee is pins it in the middle of the leg
+    // there, and the fit goes on. Its joints equal the CLI's with the page's pin as the markers.
+    const choices = await page.evaluate(() => [...document.querySelectorAll('#rt-pin-joint option')].map((o) => o.textContent));
+    check(choices.length > 30 && /named in the message/.test(choices[1]), `Click to pin's joints: ${JSON.stringify(choices.slice(0, 4))} (${choices.length})`);
+    await page.selectOption('#rt-pin-joint', 'LowerLeg.L');
+    const hint = await page.textContent('#rt-pins-info');
+    check(/Click on CesiumMan\.glb where LowerLeg\.L is/.test(hint), `the hint while placing: "${hint}"`);
+    const knee = own.leg_joint_L_2;
+    const at = await page.evaluate((p) => window.__meshmorph.hooks.retargetPointOnScreen(p), knee);
+    const fitsBeforeClick = (await rtState(page)).fit.fits;
+    await page.mouse.click(at.x, at.y);
+    await page.waitForFunction((n) => window.__meshmorph.state.retarget.fit.status !== 'fitting' && window.__meshmorph.state.retarget.fit.fits > n, fitsBeforeClick, { timeout: 120000 })
+      .catch(async (e) => {
+        const st = await rtState(page);
+        throw new Error(`${e.message}: pins ${JSON.stringify(st.pins)}, fit ${JSON.stringify(st.fit)}, info "${await page.textContent('#rt-pins-info')}"`);
+      });
+    const clicked = await rtState(page);
+    check(clicked.fit.status === 'done' && clicked.joints > 0 && Object.keys(clicked.pins).join() === 'LowerLeg.L', `after the click: pins ${JSON.stringify(clicked.pins)}, fit ${JSON.stringify(clicked.fit)}`);
+    const pin = clicked.pins['LowerLeg.L'];
+    const hKnee = heightOf(Object.values(own).flat());
+    record(browser, 'retarget RobotExpressive → CesiumMan, LowerLeg.L pinned by a click at his knee: pin to his knee joint (/ height)', (Math.hypot(...pin.map((v, c) => v - knee[c])) / hKnee).toFixed(4));
+    check(Math.hypot(...pin.map((v, c) => v - knee[c])) < 0.05 * hKnee, `the clicked pin ${JSON.stringify(pin)} is far from the knee ${JSON.stringify(knee)}`);
+    check(await page.evaluate(() => window.__meshmorph.state.error) == null, 'the refusal\'s banner stayed after the click made the fit');
+    const clickedJoints = await page.evaluate(() => window.__meshmorph.hooks.retargetJoints());
+    const clickFile = path.join(shotDir, 'robot-in-cesiumman-clicked-pin.json');
+    fs.writeFileSync(clickFile, JSON.stringify(clicked.pins));
+    const cliClickFile = path.join(shotDir, 'robot-in-cesiumman-clicked-joints.json');
+    cli(['joints', cesium, '--like', robot, '--markers', clickFile, '--out', cliClickFile], 'joints --markers (the clicked pin)');
+    const byCliClick = JSON.parse(fs.readFileSync(cliClickFile, 'utf8'));
+    const hc = heightOf(clickedJoints.positions.flat());
+    const worstClick = Math.max(...clickedJoints.names.map((n, j) => (n in byCliClick ? Math.hypot(...clickedJoints.positions[j].map((v, c) => v - byCliClick[n][c])) : Infinity)));
+    record(browser, 'retarget RobotExpressive → CesiumMan, 1 pin clicked after the refusal: page vs CLI joints (max / height)', (worstClick / hc).toExponential(2));
+    check(clickedJoints.names.length === Object.keys(byCliClick).length && worstClick / hc < 1e-5, `the page's joints after the click differ from the CLI's by ${worstClick / hc} of the height`);
+    await nextFrame(page);
+    await shot(page, 'retarget-17b-pin-clicked');
+    // Then the five from a file (replacing the clicked one).
     const pick = { 'LowerLeg.L': 'leg_joint_L_2', 'LowerLeg.R': 'leg_joint_R_2', 'LowerArm.L': 'Skeleton_arm_joint_L__3_', 'LowerArm.R': 'Skeleton_arm_joint_R__2_', Neck: 'Skeleton_neck_joint_1' };
     const markersFile = path.join(shotDir, 'robot-in-cesiumman-markers.json');
     fs.writeFileSync(markersFile, JSON.stringify(Object.fromEntries(Object.entries(pick).map(([r, c]) => [r, own[c]]))));

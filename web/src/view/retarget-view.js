@@ -432,6 +432,51 @@ export class RetargetView {
     };
   }
 
+  // The point inside the target under a client pixel, where a click places a pin: the middle of
+  // the stretch of the view ray inside the surface shown (from where it enters the mesh to where
+  // it next leaves it), in target coordinates — the limb's centre in depth, as a marker is placed
+  // on a front view. Null where the pixel misses the target. Called in the rest pose.
+  insidePointAt(clientX, clientY) {
+    const { camera, rect } = this.view('target');
+    if (!this.targetMesh.visible || clientX < rect.left || clientX > rect.left + rect.width
+        || clientY < rect.top || clientY > rect.top + rect.height) return null;
+    const ndc = new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
+    const raycaster = new THREE.Raycaster();
+    raycaster.setFromCamera(ndc, camera);
+    this.group.updateMatrixWorld(true);
+    this.targetMesh.geometry.computeBoundingSphere(); // the positions shown may have moved
+    const hits = raycaster.intersectObject(this.targetMesh, false); // both faces: the material is double-sided
+    if (!hits.length) return null;
+    // The display scales the target to height 1: a millionth of that separates two crossings.
+    const exit = hits.find((h) => h.distance > hits[0].distance + 1e-6);
+    const world = exit ? hits[0].point.clone().lerp(exit.point, 0.5) : hits[0].point.clone();
+    return world.applyMatrix4(this.sides.target.root.matrixWorld.clone().invert()).toArray();
+  }
+
+  // A click (press and release within a few pixels, so an orbit is not one) on the target pane
+  // while canClick() says placing is on: onClick(clientX, clientY). A press that starts a joint's
+  // drag is not a click (attach this after attachJointDrag: its listener runs first).
+  // Returns a function that detaches the listeners.
+  attachTargetClick({ canClick = () => false, onClick = () => {} }) {
+    const parent = this.viewer.renderer.domElement.parentElement;
+    let down = null;
+    const press = (e) => {
+      down = e.button === 0 && this.active && this.dragging < 0 && canClick() ? { x: e.clientX, y: e.clientY, id: e.pointerId } : null;
+    };
+    const release = (e) => {
+      if (!down || e.pointerId !== down.id) return;
+      const moved = Math.hypot(e.clientX - down.x, e.clientY - down.y);
+      down = null;
+      if (moved <= 4 && canClick()) onClick(e.clientX, e.clientY);
+    };
+    parent.addEventListener('pointerdown', press, true);
+    window.addEventListener('pointerup', release, true);
+    return () => {
+      parent.removeEventListener('pointerdown', press, true);
+      window.removeEventListener('pointerup', release, true);
+    };
+  }
+
   // The joint whose sphere is under a client pixel (within 10 px of its centre, the nearest), or -1.
   jointAt(clientX, clientY) {
     let best = -1;

@@ -10,7 +10,9 @@
 //     see-through target. The joints choice (`#rt-joints-from`): its skin, a joints file, or
 //     automatic (the source's skeleton fitted inside the target by the joints job, issue 14;
 //     the default for an unrigged mesh without a bundled joints file). A joint dragged with the
-//     mouse is pinned there (the fit keeps it; pins download as the CLI's --markers file).
+//     mouse is pinned there (the fit keeps it; pins download as the CLI's --markers file); a
+//     joint chosen in "Click to pin" is pinned where a click on the target lands (the middle of
+//     the limb under the pointer), also when the fit was refused and there are no joints to drag.
 //   3 retarget: method (harmonic / the LBS baseline) and the job's options (optionSchema {job:
 //     'retarget'}); any change starts a new run at once and cancels the one going
 //     (lib/retarget-runner.js): retargetPrepare, then frames in growing batches, each playable
@@ -34,7 +36,8 @@
 // retargetSeek(t), retargetJointOnScreen(j) → {x, y}, retargetCamera() → the camera position,
 // retargetPinnedDrawn() → the joints drawn as pins (red), retargetDropJoint(j, [x, y, z]) → drops
 // joint j there as the drag would (without its inside constraint), retargetSourceGraph() → the source's graph
-// nodes as drawn (following the clip).
+// nodes as drawn (following the clip), retargetPointOnScreen([x, y, z]) → the client pixel of a
+// target point, retargetInsidePointAt(x, y) → where a click there would pin a joint (or null).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
 import { clipOption, filterClips, jointsFileFor, familiesOf, librarySources, libraryTargets } from '../../lib/clip-library.js';
@@ -99,6 +102,10 @@ const markup = `
     <button id="rt-pins-clear" type="button" title="Forget every pinned joint and fit again">Clear pins</button>
     <button id="rt-pins-save" type="button" title="The pinned joints as the CLI's markers file (meshmorph retarget --target-joints auto --markers M.json)">Download pins JSON</button>
     <label class="button file" id="rt-pins-load" title="Pins from a file, the CLI's markers file {&quot;joint name&quot;: [x, y, z]}: the automatic fit keeps these joints there (also when it refused the fit without them)">Load pins…<input type="file" id="rt-pins-file" accept=".json,application/json" /></label>
+    <span id="rt-pin-click-row">
+      <label for="rt-pin-joint" title="Choose a joint of the clip's character, then click on the target where that joint is: the pin goes to the middle of the limb under the pointer (in depth), and the automatic fit keeps the joint there">Click to pin</label>
+      <select id="rt-pin-joint"><option value="">(a joint)</option></select>
+    </span>
   </div>
   <div class="row">
     <label title="Draw the target see-through with its joints (spheres) and bones (lines)"><input type="checkbox" id="rt-skeleton" checked /> Joints and bones</label>
@@ -188,6 +195,14 @@ function skinJoints(gltf) {
     });
   });
   return [...joints].map(([name, position]) => ({ name, position }));
+}
+
+// Every joint of a glTF's skins (the file's node names, skin order): the joints the automatic
+// fit places and a pin may name.
+function skeletonJointNames(gltf) {
+  const json = gltf.parser.json;
+  const names = (json.skins || []).flatMap((skin) => (skin.joints || []).map((n) => json.nodes?.[n]?.name).filter((n) => n != null));
+  return [...new Set(names)];
 }
 
 // parentOf(name) over a glTF's node hierarchy (the file's node names).
@@ -338,7 +353,7 @@ export const panel = {
       // The file's own clip names ("" when unnamed; three.js would say "animation_0").
       const names = (s.gltf.parser.json.animations || []).map((a) => a.name ?? '');
       const clips = s.gltf.animations.map((c, i) => ({ name: names[i] ?? c.name, duration: c.duration }));
-      source = { ...s, clips, parentOf: parentsOf(s.gltf) };
+      source = { ...s, clips, parentOf: parentsOf(s.gltf), jointNames: skeletonJointNames(s.gltf) };
       retarget.source = { id: s.id, name: s.name, family: s.family, clips: clips.map((c) => c.name), clip: null, clipName: null };
       $('rt-clip-filter').value = '';
       showClips();
@@ -592,7 +607,7 @@ export const panel = {
         retarget.fit = { ...retarget.fit, status: 'error', error: e.message };
         runText('');
         if (!quiet) app.showError(e);
-        $('rt-target-info').textContent = `${target.name}: the automatic joints failed (${e.message}). Choose "from a joints file", load pins for the joints it names (Load pins…), or pick a clip of another character.`;
+        $('rt-target-info').textContent = `${target.name}: the automatic joints failed (${e.message}). Pin the joints it names (Click to pin: choose one, click where it is; or Load pins…), choose "from a joints file", or pick a clip of another character.`;
         if (!quiet) showPins();
         return null;
       } finally {
@@ -608,15 +623,20 @@ export const panel = {
     function showPins() {
       const names = Object.keys(retarget.pins);
       const draggable = joints && retarget.jointsFrom !== 'skin';
-      // A refused automatic fit has no joints to drag: pins come from a file then (the core's
-      // refusal names the joints to pin).
+      // A refused automatic fit has no joints to drag: pins are placed by clicking the surface or
+      // come from a file then (the core's refusal names the joints to pin).
       const refused = !joints && retarget.jointsFrom === 'auto' && retarget.fit.status === 'error';
       $('rt-pins-row').hidden = !draggable && !refused;
       $('rt-pins-load').hidden = retarget.jointsFrom !== 'auto';
+      $('rt-pin-click-row').hidden = retarget.jointsFrom !== 'auto';
+      fillPinJoints();
       $('rt-edit-joints').disabled = !draggable;
       if (!draggable && retarget.editingJoints) setEditingJoints(false);
-      $('rt-pins-info').textContent = refused
-        ? 'No joints to drag: load pins (the CLI\'s markers file) for the joints the message names.'
+      const placing = retarget.jointsFrom === 'auto' ? $('rt-pin-joint').value : '';
+      $('rt-pins-info').textContent = placing
+        ? `Click on ${target?.name ?? 'the target'} where ${placing} is (the pin goes to the middle of the limb under the pointer).`
+        : refused
+        ? `No joints to drag: pin the joints the message names (Click to pin, or Load pins… with the CLI's markers file)${names.length ? `. Pinned: ${names.join(', ')}` : ''}.`
         : !retarget.editingJoints
         ? 'A joint in the wrong place? Edit joints, then drag it.'
         : retarget.jointsFrom === 'auto'
@@ -624,7 +644,35 @@ export const panel = {
           : 'Drag a joint to move it (the joints file changes).';
       $('rt-pins-clear').disabled = names.length === 0;
       $('rt-pins-save').disabled = names.length === 0;
-      if (joints) view.setPinned(joints.names.map((n, j) => (n in retarget.pins ? j : -1)).filter((j) => j >= 0));
+      if (joints) {
+        view.setPinned(joints.names.map((n, j) => (n in retarget.pins ? j : -1)).filter((j) => j >= 0));
+      } else if (retarget.jointsFrom === 'auto') {
+        // No fitted joints (refused, or fitting): the pins alone, drawn as pins.
+        const pinned = Object.values(retarget.pins);
+        view.setJoints(pinned, []);
+        view.setPinned(pinned.map((_, j) => j));
+        view.setJointsVisible(pinned.length > 0 || $('rt-skeleton').checked);
+      }
+    }
+
+    // The joints a click can pin: the clip character's skinned joints, those the fit's refusal
+    // names first. Kept as they are while the source and the message stay the same.
+    let pinJointsKey = '';
+    function fillPinJoints() {
+      const select = $('rt-pin-joint');
+      const all = source?.jointNames ?? [];
+      const message = retarget.fit.status === 'error' ? retarget.fit.error ?? '' : '';
+      const key = `${source?.name}|${message}`;
+      if (key === pinJointsKey) return;
+      pinJointsKey = key;
+      const words = new Set(message.split(/[\s,;:()"]+/).flatMap((w) => [w, w.replace(/\.$/, '')]));
+      const named = all.filter((n) => words.has(n));
+      const chosen = select.value;
+      const option = (n, note = '') => `<option value="${n.replace(/"/g, '&quot;')}">${n.replace(/</g, '&lt;')}${note}</option>`;
+      select.innerHTML = '<option value="">(a joint)</option>'
+        + named.map((n) => option(n, ' (named in the message)')).join('')
+        + all.filter((n) => !named.includes(n)).map((n) => option(n)).join('');
+      select.value = all.includes(chosen) ? chosen : '';
     }
 
     // Joints are edited in the rest pose (pins are rest-pose positions): playback pauses and the
@@ -649,25 +697,37 @@ export const panel = {
 
     // A joint dropped at `position` (target coordinates) by the drag below (or by the test hook
     // retargetDropJoint, which skips the drag's inside constraint to reach the core's refusal).
+    // Pins joint `name` at `position` and fits again (automatic joints). With fitted joints shown,
+    // a pin the fit refuses (outside the mesh) is taken back: the joints return to where they were
+    // and the core's message says why (`how`: what the person did, for that message). Without
+    // (the fit was refused), the pin stays: the refusal may need more than one.
+    function pinJoint(name, position, how) {
+      if (!joints) {
+        retarget.pins = { ...retarget.pins, [name]: position };
+        app.clearError(); // the refusal the pin answers; a new one is shown if it still holds
+        chooseJoints();
+        return;
+      }
+      const before = retarget.pins;
+      const shown = joints.positions.flat();
+      retarget.pins = { ...retarget.pins, [name]: position };
+      showPins();
+      chooseJoints(null, true).then(() => {
+        if (retarget.fit.status !== 'error') return;
+        retarget.pins = before;
+        retarget.fit = { ...retarget.fit, status: 'done' };
+        view.moveJoints(shown);
+        showPins();
+        $('rt-target-info').textContent = `${name} was not pinned: ${retarget.fit.error.replace(/\.?$/, '.')} ${how} inside ${target.name}.`;
+        if (retarget.run.status !== 'done') startRun();
+        refresh();
+      });
+    }
+
     const dropJoint = (j, position) => {
       const name = joints.names[j];
       if (retarget.jointsFrom === 'auto') {
-        const before = retarget.pins;
-        const shown = joints.positions.flat();
-        retarget.pins = { ...retarget.pins, [name]: position };
-        showPins();
-        // A pin the fit refuses (dropped outside the mesh) is taken back: the joints return to
-        // where they were and the core's message says why.
-        chooseJoints(null, true).then(() => {
-          if (retarget.fit.status !== 'error') return;
-          retarget.pins = before;
-          retarget.fit = { ...retarget.fit, status: 'done' };
-          view.moveJoints(shown);
-          showPins();
-          $('rt-target-info').textContent = `${joints.names[j]} was not pinned: ${retarget.fit.error.replace(/\.?$/, '.')} Drop it inside ${target.name}.`;
-          if (retarget.run.status !== 'done') startRun();
-          refresh();
-        });
+        pinJoint(name, position, 'Drop it');
         return;
       }
       // Joints from a file: the moved joint is the new file (download it with Download joints JSON).
@@ -680,6 +740,31 @@ export const panel = {
     view.attachJointDrag({
       canDrag: () => retarget.editingJoints && Boolean(joints) && retarget.jointsFrom !== 'skin' && retarget.fit.status !== 'fitting',
       onDrop: dropJoint,
+    });
+    // Click to pin: a joint chosen in #rt-pin-joint is pinned where the next click on the target
+    // lands (view.insidePointAt), in the rest pose; then the choice clears.
+    $('rt-pin-joint').addEventListener('change', () => {
+      if ($('rt-pin-joint').value) {
+        if (joints) setEditingJoints(true);
+        else {
+          setPlaying(false);
+          showRest();
+        }
+      }
+      showPins();
+    });
+    view.attachTargetClick({
+      canClick: () => retarget.jointsFrom === 'auto' && Boolean(target) && Boolean($('rt-pin-joint').value) && retarget.fit.status !== 'fitting',
+      onClick: (x, y) => {
+        const name = $('rt-pin-joint').value;
+        const position = view.insidePointAt(x, y);
+        if (!position) {
+          $('rt-pins-info').textContent = `That click missed ${target.name}: click on it where ${name} is.`;
+          return;
+        }
+        $('rt-pin-joint').value = '';
+        pinJoint(name, position, 'Click');
+      },
     });
     $('rt-pins-clear').addEventListener('click', () => {
       retarget.pins = {};
@@ -1203,6 +1288,8 @@ export const panel = {
     app.hooks.retargetPinnedDrawn = () => view.joints.spheres.flatMap((sp, j) => (sp.material === view.pinnedMaterial ? [j] : []));
     app.hooks.retargetJointOnScreen = (j) => (view.joints.spheres[j] ? view.toScreen('target', view.joints.spheres[j].position.toArray()) : null);
     app.hooks.retargetJointAt = (x, y) => view.jointAt(x, y);
+    app.hooks.retargetPointOnScreen = (p) => view.toScreen('target', p);
+    app.hooks.retargetInsidePointAt = (x, y) => view.insidePointAt(x, y);
     app.hooks.retargetDropJoint = (j, position) => dropJoint(j, position);
     app.hooks.retargetCamera = () => viewer.camera.position.toArray();
     app.hooks.retargetJoints = () => (joints ? { names: [...joints.names], positions: joints.positions.map((p) => [...p]), bones: joints.bones.map((b) => [...b]) } : null);
