@@ -40,6 +40,8 @@ const OptionSchema<JointsJobOptions>& joints_options() {
              "the prior is used in full while the fitted bones differ from the source's by at most this (relative), and not at all beyond 1.6 x this");
     s.integer("marker_reach", [](O& o) -> int& { return o.fit.marker_reach; }, 0, 100,
               "markers also move joints up to this many bones away");
+    s.number("marker_anchor", [](O& o) -> double& { return o.fit.marker_anchor; }, 0, 1,
+             "a marker within this x height of the target's skeleton path re-anchors the proportions along it (0 = off)");
     s.boolean("check_topology", [](O& o) -> bool& { return o.fit.check_topology; },
               "refuse a source of another kind (biped vs quadruped)");
     s.choice<io::SurfaceSelection>("surface", [](O& o) -> io::SurfaceSelection& { return o.surface; },

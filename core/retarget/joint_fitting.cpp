@@ -823,6 +823,77 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
   JointSet& out = r.joints;
   std::vector<int> out_index(source_joints.size(), -1);
   std::vector<std::string> outside;
+  // Arc length along a source path of the point at fraction t of edge (e, parent e), or −1 when the
+  // path does not hold that edge.
+  auto arc_on_source = [&](const JfPath& ps, int e, double t) {
+    for (size_t k = 0; k + 1 < ps.nodes.size(); ++k)
+      if ((ps.nodes[k] == e && ps.nodes[k + 1] == SS.parent[e]) || (ps.nodes[k + 1] == e && ps.nodes[k] == SS.parent[e]))
+        return ps.arc[k] + (ps.nodes[k] == e ? t : 1 - t) * (ps.arc[k + 1] - ps.arc[k]);
+    return -1.0;
+  };
+  // Markers as anchors along the paths (proportions along branches re-measured from them): a
+  // marked joint's closest point on the source path and the marker's closest point on the target
+  // path (when the marker lies within marker_anchor × height of it) are one more pair of
+  // corresponding positions beside the branch points, so the joints of a marked chain are spread
+  // between the marker and its neighbouring branch points, not only dragged toward it (step 6).
+  struct MarkerAnchor {
+    int e;
+    double t;
+    Eigen::Vector3d m;
+  };
+  std::vector<MarkerAnchor> anchors;
+  const double Ht = jf_frame(Vt, ut).H;
+  if (opt.marker_anchor > 0)
+    for (const JointMarker& mk : markers) {
+      const int k = source_joints.find(mk.name);
+      if (k < 0 || !mk.position.allFinite()) continue;  // step 6 reports it
+      MarkerAnchor a{-1, 0, mk.position};
+      closest_on_edges(source_joints.P.row(k).transpose(), matched_edges, &a.e, &a.t);
+      if (a.e >= 0) anchors.push_back(a);
+    }
+  auto arc_on_target = [&](const JfPath& pt, const Eigen::Vector3d& m) {
+    double best = std::numeric_limits<double>::infinity(), arc = -1;
+    for (size_t k = 0; k + 1 < pt.nodes.size(); ++k) {
+      const Eigen::Vector3d x = tt.pos(pt.nodes[k]), y = tt.pos(pt.nodes[k + 1]);
+      const double l2 = (y - x).squaredNorm();
+      const double u = l2 > 0 ? std::clamp((m - x).dot(y - x) / l2, 0.0, 1.0) : 0.0;
+      const double d = (m - x - u * (y - x)).norm();
+      if (d < best) best = d, arc = pt.arc[k] + u * (pt.arc[k + 1] - pt.arc[k]);
+    }
+    return best <= opt.marker_anchor * Ht ? arc : -1.0;
+  };
+  // Per pair of matched ends: (source arc, target arc) of its branch points and marker anchors, by
+  // source arc, target arcs increasing (an anchor out of order with them is left out).
+  std::vector<std::vector<std::pair<double, double>>> breaks(pairs.size());
+  for (size_t ip = 0; ip < pairs.size(); ++ip) {
+    const PairPaths& pp = pairs[ip];
+    // Branch points grouped by position along the source path; a group's target arc is the mean.
+    std::vector<std::pair<double, std::vector<int>>> groups;
+    std::vector<int> labels = {-1, -2};
+    for (int c = 0; c < nm; ++c)
+      if (c != pp.a && c != pp.b) labels.push_back(c);
+    for (int c : labels) {
+      const double x = label_arc(st, pp.ps, pp.a, pp.b, c, true);
+      auto it = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return std::abs(g.first - x) < 1e-12; });
+      if (it == groups.end()) groups.push_back({x, {c}});
+      else it->second.push_back(c);
+    }
+    std::stable_sort(groups.begin(), groups.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    std::vector<std::pair<double, double>>& b = breaks[ip];
+    for (const auto& g : groups) {
+      double x = 0;
+      for (int c : g.second) x += label_arc(tt, pp.pt, pp.a, pp.b, c, false);
+      b.push_back({g.first, x / g.second.size()});
+    }
+    for (const MarkerAnchor& a : anchors) {
+      const double s = arc_on_source(pp.ps, a.e, a.t);
+      const double x = s >= 0 ? arc_on_target(pp.pt, a.m) : -1.0;
+      if (x < 0) continue;
+      const auto at = std::upper_bound(b.begin(), b.end(), s, [](double v, const auto& g) { return v < g.first; });
+      if (at == b.begin() || at == b.end() || !(std::prev(at)->first < s) || !(std::prev(at)->second < x) || !(x < at->second)) continue;
+      b.insert(at, {s, x});
+    }
+  }
   for (int j : used) {
     const Eigen::Vector3d pj = source_joints.P.row(j).transpose();
     int e;
@@ -832,40 +903,16 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     double rsum = 0;
     int n = 0;
-    for (const PairPaths& pp : pairs) {
-      // Arc length of q along this source path, if the path holds edge e.
-      int i = -1;
-      for (size_t k = 0; k + 1 < pp.ps.nodes.size(); ++k)
-        if ((pp.ps.nodes[k] == e && pp.ps.nodes[k + 1] == SS.parent[e]) ||
-            (pp.ps.nodes[k + 1] == e && pp.ps.nodes[k] == SS.parent[e])) {
-          i = int(k);
-          break;
-        }
-      if (i < 0) continue;
-      const double len = pp.ps.arc[i + 1] - pp.ps.arc[i];
-      const double s = pp.ps.arc[i] + (pp.ps.nodes[i] == e ? t : 1 - t) * len;
-      // Branch points grouped by position along the source path.
-      std::vector<std::pair<double, std::vector<int>>> groups;
-      std::vector<int> labels = {-1, -2};
-      for (int c = 0; c < nm; ++c)
-        if (c != pp.a && c != pp.b) labels.push_back(c);
-      for (int c : labels) {
-        const double x = label_arc(st, pp.ps, pp.a, pp.b, c, true);
-        auto it = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return std::abs(g.first - x) < 1e-12; });
-        if (it == groups.end()) groups.push_back({x, {c}});
-        else it->second.push_back(c);
-      }
-      std::stable_sort(groups.begin(), groups.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    for (size_t ip = 0; ip < pairs.size(); ++ip) {
+      const PairPaths& pp = pairs[ip];
+      const double s = arc_on_source(pp.ps, e, t);  // q along this source path, if it holds edge e
+      if (s < 0) continue;
+      const std::vector<std::pair<double, double>>& b = breaks[ip];
       size_t k = 0;
-      while (k + 2 < groups.size() && groups[k + 1].first <= s) ++k;
-      const double span = groups[k + 1].first - groups[k].first;
-      const double tau = span > 0 ? std::clamp((s - groups[k].first) / span, 0.0, 1.0) : 0.0;
-      auto target_arc = [&](const std::vector<int>& g) {
-        double x = 0;
-        for (int c : g) x += label_arc(tt, pp.pt, pp.a, pp.b, c, false);
-        return x / g.size();
-      };
-      const double lo = target_arc(groups[k].second), hi = target_arc(groups[k + 1].second);
+      while (k + 2 < b.size() && b[k + 1].first <= s) ++k;
+      const double span = b[k + 1].first - b[k].first;
+      const double tau = span > 0 ? std::clamp((s - b[k].first) / span, 0.0, 1.0) : 0.0;
+      const double lo = b[k].second, hi = b[k + 1].second;
       Eigen::Vector3d x;
       double rx;
       jf_point_at(tt, pp.pt, lo + tau * (hi - lo), &x, &rx);

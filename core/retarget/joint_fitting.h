@@ -18,7 +18,9 @@
 //     matched end c) and its fraction along it; the same labelled segment of the target path
 //     a′–b′ at the same fraction gives a target point (proportions along branches). The target
 //     joint is the mean over pairs plus the joint's offset from q, turned into the target's axes
-//     and scaled by the ratio of the local radii;
+//     and scaled by the ratio of the local radii. A marker lying near a target path (marker_anchor)
+//     is one more pair of corresponding positions on it beside the branch points: the joints of a
+//     marked chain are spread between the marker and the branch points around it;
 //  5b. each joint is then moved by the local affine map that takes the source surface around it
 //     (posed onto the fitted joints bone by bone) to its closest target points — a joint centred
 //     in a thigh stays centred in a thicker one; a few rounds, each move at most twice the
@@ -83,6 +85,8 @@ struct JointFitOptions {
   double skeleton_prior_agreement = 0.15;  // ... full while the fitted bones differ from those by ≤ this (Σ|d − b| / Σ|b|),
                                    // fading to 0 at 1.6 × this (a target of the source's rig family)
   int marker_reach = 3;           // markers move unpinned joints up to this many bones away (0 = only pin)
+  double marker_anchor = 0.1;     // step 5: a marker within this × height of a target path between matched ends
+                                  // anchors the proportions along it (0 = off)
   bool check_topology = true;     // refuse a mismatch (step 4); false = fit whatever matches
 };
 
