@@ -515,6 +515,7 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     check(/pin those joints with markers/.test(refusal) && /Load pins/.test(refusal), `the refusal: "${refusal}"`);
     check(await page.isVisible('#rt-pins-load'), 'no Load pins… after the refused fit');
     check(await page.isDisabled('#rt-edit-joints'), 'Edit joints is offered with no joints to edit');
+    await page.evaluate(() => document.querySelector('#rt-pins-row').scrollIntoView({ block: 'center' }));
     await shot(page, 'retarget-17-fit-refused');
     await page.evaluate(() => { window.__meshmorph.state.error = null; });
     // Markers at CesiumMan's own knees, elbows and neck (its self fit by the CLI: its skin's
@@ -557,6 +558,7 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     record(browser, 'retarget RobotExpressive → CesiumMan, 1 pin clicked after the refusal: page vs CLI joints (max / height)', (worstClick / hc).toExponential(2));
     check(clickedJoints.names.length === Object.keys(byCliClick).length && worstClick / hc < 1e-5, `the page's joints after the click differ from the CLI's by ${worstClick / hc} of the height`);
     await nextFrame(page);
+    await page.evaluate(() => document.querySelector('#rt-pins-row').scrollIntoView({ block: 'center' }));
     await shot(page, 'retarget-17b-pin-clicked');
     // Then the five from a file (replacing the clicked one).
     const pick = { 'LowerLeg.L': 'leg_joint_L_2', 'LowerLeg.R': 'leg_joint_R_2', 'LowerArm.L': 'Skeleton_arm_joint_L__3_', 'LowerArm.R': 'Skeleton_arm_joint_R__2_', Neck: 'Skeleton_neck_joint_1' };
