@@ -357,6 +357,8 @@ export const panel = {
       retarget.source = { id: s.id, name: s.name, family: s.family, clips: clips.map((c) => c.name), clip: null, clipName: null };
       $('rt-clip-filter').value = '';
       showClips();
+      // The new character in its rest pose until a clip is picked (the last one's stayed on screen).
+      view.setSource(s.gltf, -1);
       $('rt-source-info').textContent = `${s.label || s.name}: ${s.gltf.animations.length} clip${s.gltf.animations.length === 1 ? '' : 's'}. Pick one.`;
       app.setStatus(`${s.label || s.name}: ${s.gltf.animations.length} clips`);
       // A source of another skeleton: a bundled target's joints file depends on it.
