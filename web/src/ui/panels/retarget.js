@@ -518,7 +518,8 @@ export const panel = {
           const pinned = Object.keys(retarget.pins).length;
           setJoints(list, bones, pinned ? `the automatic fit with ${pinned} pinned` : 'the automatic fit');
           view.setTargetUp(fitted.info.targetUp); // the fit found which way is up: stand it upright
-          if (warnings.length) $('rt-target-info').textContent += ` ${warnings.join(' ')}`;
+          // The core's warnings are clauses without a full stop: one sentence each.
+          if (warnings.length) $('rt-target-info').textContent += ` ${warnings.filter(Boolean).map((w) => `${w[0].toUpperCase()}${w.slice(1).replace(/\.?$/, '.')}`).join(' ')}`;
           jointsText = json;
         } else {
           let text = null;
