@@ -564,8 +564,11 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     const pick = { 'LowerLeg.L': 'leg_joint_L_2', 'LowerLeg.R': 'leg_joint_R_2', 'LowerArm.L': 'Skeleton_arm_joint_L__3_', 'LowerArm.R': 'Skeleton_arm_joint_R__2_', Neck: 'Skeleton_neck_joint_1' };
     const markersFile = path.join(shotDir, 'robot-in-cesiumman-markers.json');
     fs.writeFileSync(markersFile, JSON.stringify(Object.fromEntries(Object.entries(pick).map(([r, c]) => [r, own[c]]))));
+    // A new fit (the clicked pin's fit is done already: the file's change event is handled after
+    // setInputFiles returns).
+    const fitsBeforeFile = (await rtState(page)).fit.fits;
     await page.setInputFiles('#rt-pins-file', markersFile);
-    await page.waitForFunction(() => window.__meshmorph.state.retarget.fit.status === 'done' && window.__meshmorph.state.retarget.joints > 0, null, { timeout: 120000 })
+    await page.waitForFunction((n) => window.__meshmorph.state.retarget.fit.fits > n && window.__meshmorph.state.retarget.fit.status === 'done' && window.__meshmorph.state.retarget.joints > 0, fitsBeforeFile, { timeout: 120000 })
       .catch(async (e) => {
         const st = await rtState(page);
         throw new Error(`${e.message}: pins ${JSON.stringify(st.pins)}, fit ${JSON.stringify(st.fit)}, info "${await page.textContent('#rt-target-info')}"`);
