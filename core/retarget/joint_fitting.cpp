@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <optional>
 
 #include "retarget/bone_blend.h"
 #include "spatial/triangle_bvh.h"
@@ -842,7 +843,6 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     Eigen::Vector3d m;
   };
   std::vector<MarkerAnchor> anchors;
-  const double Ht = jf_frame(Vt, ut).H;
   if (opt.marker_anchor > 0)
     for (const JointMarker& mk : markers) {
       const int k = source_joints.find(mk.name);
@@ -860,7 +860,7 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
       const double d = (m - x - u * (y - x)).norm();
       if (d < best) best = d, arc = pt.arc[k] + u * (pt.arc[k + 1] - pt.arc[k]);
     }
-    return best <= opt.marker_anchor * Ht ? arc : -1.0;
+    return best <= opt.marker_anchor * ft.H ? arc : -1.0;  // ft.H: the target's height
   };
   // Per pair of matched ends: (source arc, target arc) of its branch points and marker anchors, by
   // source arc, target arcs increasing (an anchor out of order with them is left out).
@@ -1144,7 +1144,6 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
   // (KayKit Knight → human_woman with a marker on her hips: 9.4 % of the height on the curve
   // skeleton with the limb lifted, 4.9 % on the bones; 5.8 % without markers).
   JointFitResult voxel;
-  const JointFitResult curve_r = r;
   const bool auto_tree = opt.source_skeleton == SourceSkeleton::Auto;
   if (opt.source_skeleton != SourceSkeleton::Bones) {
     bool lost = false;
@@ -1153,14 +1152,17 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
     if (voxel.status.ok() || !auto_tree || !lost) return voxel;
   }
   const size_t voxel_ends = r.source_skeleton.leaves().size();
+  // The curve skeleton's inputs, for the markers' last try below (only then worth the copy).
+  std::optional<JointFitResult> curve_r;
+  if (!markers.empty() && auto_tree) curve_r = r;
   r.source_skeleton = jf_bone_skeleton(r.source_skeleton, source_joints, used, bvh_s);
   if (!r.source_skeleton.status.ok()) return fail(r.source_skeleton.status.code, r.source_skeleton.status.message);
   JointFitResult bones = jf_fit_on_skeletons(r, in, false, nullptr, true);
   bones.source_tree = SourceSkeleton::Bones;
   if (opt.source_skeleton == SourceSkeleton::Bones) return bones;
   if (!bones.status.ok()) {
-    if (!markers.empty()) {  // neither tree fits: the curve skeleton's lost limbs from the markers
-      JointFitResult lifted = jf_fit_on_skeletons(curve_r, in, true, nullptr, true);
+    if (curve_r) {  // neither tree fits: the curve skeleton's lost limbs from the markers
+      JointFitResult lifted = jf_fit_on_skeletons(*curve_r, in, true, nullptr, true);
       lifted.source_tree = SourceSkeleton::Voxel;
       if (lifted.status.ok()) return lifted;
     }

@@ -369,11 +369,7 @@ export class RetargetView {
     const parent = canvas.parentElement;
     let drag = null; // {j, plane, flat, pointerId}
     const local = (clientX, clientY) => {
-      const { camera, rect } = this.view('target');
-      const ndc = new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
-      const ray = new THREE.Raycaster();
-      ray.setFromCamera(ndc, camera);
-      const hit = ray.ray.intersectPlane(drag.plane, new THREE.Vector3());
+      const hit = this.targetRay(clientX, clientY).ray.intersectPlane(drag.plane, new THREE.Vector3());
       return hit ? hit.applyMatrix4(this.sides.target.root.matrixWorld.clone().invert()) : null;
     };
     const down = (e) => {
@@ -432,17 +428,24 @@ export class RetargetView {
     };
   }
 
+  // A raycaster through a client pixel of the target's pane (world coordinates).
+  targetRay(clientX, clientY) {
+    const { camera, rect } = this.view('target');
+    const ndc = new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
+    const raycaster = new THREE.Raycaster();
+    raycaster.setFromCamera(ndc, camera);
+    return raycaster;
+  }
+
   // The point inside the target under a client pixel, where a click places a pin: the middle of
   // the stretch of the view ray inside the surface shown (from where it enters the mesh to where
   // it next leaves it), in target coordinates — the limb's centre in depth, as a marker is placed
   // on a front view. Null where the pixel misses the target. Called in the rest pose.
   insidePointAt(clientX, clientY) {
-    const { camera, rect } = this.view('target');
+    const { rect } = this.view('target');
     if (!this.targetMesh.visible || clientX < rect.left || clientX > rect.left + rect.width
         || clientY < rect.top || clientY > rect.top + rect.height) return null;
-    const ndc = new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
-    const raycaster = new THREE.Raycaster();
-    raycaster.setFromCamera(ndc, camera);
+    const raycaster = this.targetRay(clientX, clientY);
     this.group.updateMatrixWorld(true);
     this.targetMesh.geometry.computeBoundingSphere(); // the positions shown may have moved
     const hits = raycaster.intersectObject(this.targetMesh, false); // both faces: the material is double-sided

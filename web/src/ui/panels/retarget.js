@@ -671,10 +671,8 @@ export const panel = {
       const words = new Set(message.split(/[\s,;:()"]+/).flatMap((w) => [w, w.replace(/\.$/, '')]));
       const named = all.filter((n) => words.has(n));
       const chosen = select.value;
-      const option = (n, note = '') => `<option value="${n.replace(/"/g, '&quot;')}">${n.replace(/</g, '&lt;')}${note}</option>`;
-      select.innerHTML = '<option value="">(a joint)</option>'
-        + named.map((n) => option(n, ' (named in the message)')).join('')
-        + all.filter((n) => !named.includes(n)).map((n) => option(n)).join('');
+      select.replaceChildren(new Option('(a joint)', ''), ...named.map((n) => new Option(`${n} (named in the message)`, n)),
+        ...all.filter((n) => !named.includes(n)).map((n) => new Option(n, n)));
       select.value = all.includes(chosen) ? chosen : '';
     }
 
