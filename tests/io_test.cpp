@@ -1,6 +1,11 @@
 // Tests of core/io: loading every format from data/, round trips, conversions, malformed input.
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -8,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "io/asset.h"
+#include "io/io_text.h"
 #include "mesh/validate.h"
 #include "test_support.h"
 
@@ -404,4 +410,45 @@ TEST(IoConvert, GltfToObjKeepsUVsAndRawLayout) {
   const std::string s(text.begin(), text.end());
   EXPECT_NE(s.find("\nvt "), std::string::npos);
   EXPECT_NE(s.find("\nf 1/1 2/2 3/3\n"), std::string::npos);
+}
+
+// ---------------------------------------------------------------- number tokens
+
+// The readers' double parsing (io_text.cpp: Clinger's fast path, strtod otherwise) must give
+// strtod's value bit for bit and accept exactly what strtod accepts as a whole token.
+TEST(IoText, NumbersReadExactlyAsStrtod) {
+  auto reference = [](const std::string& t, double* v) {
+    if (t.empty()) return false;
+    char* end = nullptr;
+    errno = 0;
+    *v = std::strtod(t.c_str(), &end);
+    return end == t.c_str() + t.size() && !(errno == ERANGE && std::isinf(*v));
+  };
+  std::vector<std::string> tokens = {"0", "-0", "-0.0", "+0.5", ".5", "5.", "-.5e1", "1e22", "1e23", "1e-22", "1e-23",
+                                     "9007199254740992", "9007199254740993", "123456789012345678", "1234567890123456789",
+                                     "0.000000000000000000000000001", "00000000000000000000001.5", "1.5e+0003", "1E5",
+                                     "4.35", "0.1", "0.3", "2.2250738585072014e-308", "1.7976931348623157e308", "1e400",
+                                     "1e-400", "0e99999", "1e", "e5", ".", "-", "--1", "1.2.3", "1e5.5", "nan", "inf",
+                                     "-inf", "0x1p3", "1,5", " 1", "1 ", "112.863998", "-0.224207"};
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> exp10(-30, 30);
+  char buf[64];
+  for (int i = 0; i < 20000; ++i) {
+    const double x = unit(rng) * std::pow(10.0, exp10(rng));
+    static const char* const formats[] = {"%.6f", "%.9g", "%.15g", "%.17g", "%e", "%.3e", "%.12f"};
+    std::snprintf(buf, sizeof(buf), formats[i % 7], x);
+    tokens.push_back(buf);
+  }
+  int fast_agree = 0;
+  for (const std::string& t : tokens) {
+    double want = 0, got = 0;
+    const bool ok_want = reference(t, &want);
+    const bool ok_got = mm::io::detail::parse_double_token(t, &got);
+    ASSERT_EQ(ok_got, ok_want) << "'" << t << "'";
+    if (!ok_want) continue;
+    ASSERT_EQ(std::memcmp(&want, &got, sizeof(double)), 0) << "'" << t << "': " << want << " vs " << got;
+    ++fast_agree;
+  }
+  EXPECT_GT(fast_agree, 20000);
 }

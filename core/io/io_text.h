@@ -28,6 +28,8 @@ class TextLines {
 
 // Whitespace-separated tokens of a line.
 std::vector<std::string_view> split_tokens(std::string_view line);
+// The same into *out (cleared first), reusing its storage: the readers call it once a line.
+void split_tokens(std::string_view line, std::vector<std::string_view>* out);
 // The line without a trailing comment starting at `comment` and without surrounding blanks.
 std::string_view strip_comment(std::string_view line, char comment);
 

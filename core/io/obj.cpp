@@ -61,10 +61,11 @@ Status load_obj(const std::vector<uint8_t>& bytes, Asset* asset) {
   std::string_view line;
   std::string message;
   int skipped_elements = 0;
+  std::vector<std::string_view> tok;  // one line's tokens, storage reused
   while (reader.next(&line)) {
     const int line_no = reader.line_number();
     doc->lines.emplace_back(line);
-    const std::vector<std::string_view> tok = split_tokens(strip_comment(line, '#'));
+    split_tokens(strip_comment(line, '#'), &tok);
     if (tok.empty()) continue;
     const std::string_view key = tok[0];
     auto error = [&](const std::string& what) {

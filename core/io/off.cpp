@@ -29,7 +29,7 @@ Status load_off(const std::vector<uint8_t>& bytes, Asset* asset) {
         continue;
       }
       *stripped = s;
-      *tok = split_tokens(s);
+      split_tokens(s, tok);
       return true;
     }
     return false;
@@ -83,7 +83,8 @@ Status load_off(const std::vector<uint8_t>& bytes, Asset* asset) {
     const size_t rest = static_cast<size_t>(tok[2].data() + tok[2].size() - stripped.data());
     doc->vertex_extra.emplace_back(stripped.substr(rest));
   }
-  std::vector<int> tri;
+  std::vector<int> tri, poly;
+  tri.reserve(static_cast<size_t>(nf) * 3);
   for (long long i = 0; i < nf; ++i) {
     if (!next_tokens(&tok, &stripped))
       return Status::error(StatusCode::ParseError, name + ": header declares " + std::to_string(nf) +
@@ -96,7 +97,7 @@ Status load_off(const std::vector<uint8_t>& bytes, Asset* asset) {
     if (n > static_cast<long long>(tok.size()) - 1)  // not n + 1: n may be LLONG_MAX
       return error(StatusCode::ParseError, "face declares " + std::to_string(n) + " corners but lists " +
                                                std::to_string(tok.size() - 1));
-    std::vector<int> poly(static_cast<size_t>(n));
+    poly.resize(static_cast<size_t>(n));
     for (long long c = 0; c < n; ++c) {
       long long k = 0;
       if (!parse_int_token(tok[1 + c], &k))
