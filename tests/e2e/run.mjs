@@ -851,6 +851,29 @@ async function clickLandmark(page, side, candidates) {
   throw new Error(`${side}: no hover pick at any of the vertices ${candidates.map((c) => c.vertex).join(', ')}`);
 }
 
+// With pair `index` selected, a real click at a vertex of `side` moves that end of the pair
+// (candidates as for clickLandmark); returns the vertex the page put there after checking it is
+// under the pointer.
+async function moveLandmark(page, side, index, candidates) {
+  const k = side === 'reference' ? 0 : 1;
+  const before = (await transferState(page)).pairs[index][k];
+  for (const target of candidates) {
+    await page.mouse.move(target.x, target.y, { steps: 4 });
+    const hovered = await page.waitForFunction((s) => document.getElementById('tr-hover').textContent.startsWith(s), side, { timeout: 1500 })
+      .then(() => true, () => false);
+    if (!hovered) continue;
+    await page.mouse.down();
+    await page.mouse.up();
+    await page.waitForFunction(({ i, c, b }) => window.__meshmorph.state.transfer.pairs[i][c] !== b, { i: index, c: k, b: before }, { timeout: 3000 })
+      .catch(() => { throw new Error(`${side}: the click at vertex ${target.vertex} did not move pair ${index + 1}`); });
+    const picked = (await transferState(page)).pairs[index][k];
+    const at = await page.evaluate(({ s, v }) => window.__meshmorph.hooks.transferVertexOnScreen(s, v), { s: side, v: picked });
+    check(Math.hypot(at.x - target.x, at.y - target.y) <= 3, `${side}: moved to vertex ${target.vertex} (${target.x.toFixed(1)}, ${target.y.toFixed(1)}), picked ${picked} at (${at.x.toFixed(1)}, ${at.y.toFixed(1)})`);
+    return picked;
+  }
+  throw new Error(`${side}: no hover pick at any of the vertices ${candidates.map((c) => c.vertex).join(', ')}`);
+}
+
 const meanDistance = (a, b) => {
   let sum = 0;
   for (let i = 0; i < a.length; i += 3) sum += Math.hypot(a[i] - b[i], a[i + 1] - b[i + 1], a[i + 2] - b[i + 2]);
@@ -1058,6 +1081,18 @@ it('transfer: the cat pair side by side, run and compare; landmark pairs clicked
   await page.click('table.landmarks tbody tr[data-index="2"] .pair-delete');
   t = await transferState(page);
   check(JSON.stringify(t.pairs) === JSON.stringify(clicked.slice(0, 2)), `after deleting pair 3: ${JSON.stringify(t.pairs)}`);
+  // Move pair 1's reference end: select its row, click elsewhere on the reference (the lower
+  // front); the source end, the pair count and the selection stay.
+  await page.click('table.landmarks tbody tr[data-index="0"]');
+  check((await transferState(page)).selected === 0 && /Pair 1 selected/.test(await page.textContent('#tr-landmark-hint')),
+    'selecting pair 1 did not say that a click moves it');
+  clicked[0][0] = await moveLandmark(page, 'reference', 0, await visibleOnSide(page, 'reference', '-y + z'));
+  t = await transferState(page);
+  check(JSON.stringify(t.pairs) === JSON.stringify(clicked.slice(0, 2)) && t.selected === 0 && !t.pending,
+    `after moving pair 1's reference end: ${JSON.stringify(t)}`);
+  await shot(page, '12-transfer-5b-landmark-moved');
+  await page.click('table.landmarks tbody tr[data-index="0"]');
+  check((await transferState(page)).selected === -1, 'a second click on the row did not deselect the pair');
 
   // Save the landmark JSON (the CLI's format).
   const [json] = await Promise.all([page.waitForEvent('download', { timeout: 30000 }), page.click('#tr-landmarks-save')]);

@@ -109,6 +109,10 @@ test('landmark clicks pair a reference vertex with a source vertex in either ord
   assert.equal(l.click('source', 1), 'pending');
   assert.equal(l.click('reference', 2), 'paired');
   assert.deepEqual(l.pairs, [[4, 9], [2, 1]]);
+  l.move(1, 'source', 7); // a selected pair's end clicked elsewhere
+  l.move(1, 'reference', 5);
+  l.move(2, 'reference', 8); // no such pair: nothing changes
+  assert.deepEqual(l.pairs, [[4, 9], [5, 7]]);
   l.remove(0);
-  assert.deepEqual(l.pairs, [[2, 1]]);
+  assert.deepEqual(l.pairs, [[5, 7]]);
 });

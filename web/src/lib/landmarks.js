@@ -26,6 +26,13 @@ export class LandmarkPairs {
     return 'paired';
   }
 
+  // Moves the `side` end of pair `index` to welded vertex `vertex` (a selected pair's end is
+  // re-clicked where it belongs); the other end stays.
+  move(index, side, vertex) {
+    if (index < 0 || index >= this.pairs.length) return;
+    this.pairs[index][side === 'reference' ? 0 : 1] = vertex;
+  }
+
   remove(index) {
     this.pairs.splice(index, 1);
   }

@@ -5,7 +5,7 @@
 //   3 landmark pairs — needed when the connectivity differs (same vertex count and faces: the
 //     core generates 30 pairs itself): click a vertex on the reference, then its match on the
 //     source; pairs are numbered and colour-matched on both meshes and listed in a table
-//     (select, delete); save / load as the CLI's landmark JSON (welded indices)
+//     (select, delete; a click with a pair selected moves its end); save / load as the CLI's landmark JSON (welded indices)
 //   4 run (method yin / kovnatsky / levy, options from optionSchema {job: 'transfer'})
 //   5 compare (Γ dominance, Γ heat map, flipped faces and detail change from `compare`, result
 //     against source) and export the result as GLB (the source's asset with the new positions).
@@ -228,7 +228,8 @@ export const panel = {
       let hint;
       if (!both) hint = 'Load both meshes first.';
       else if (transfer.sameConnectivity && n === 0) hint = 'Same vertex count and faces: 30 landmark pairs are generated automatically. You may still click your own (at least 6).';
-      else hint = `${n} pair${n === 1 ? '' : 's'}${n < minLandmarks ? ` — at least ${minLandmarks} needed${transfer.sameConnectivity ? ' (or none: then they are generated)' : ''}` : ''}. Click a vertex on the reference (left), then its match on the source (right).`;
+      else if (transfer.selected >= 0) hint = `Pair ${transfer.selected + 1} selected: a click on either mesh moves its end there. Click the row again to add new pairs.`;
+      else hint = `${n} pair${n === 1 ? '' : 's'}${n < minLandmarks ? ` — at least ${minLandmarks} needed${transfer.sameConnectivity ? ' (or none: then they are generated)' : ''}` : ''}. Click a vertex on the reference (left), then its match on the source (right); select a pair in the table to move it.`;
       $('tr-landmark-hint').textContent = hint;
 
       if (!meshes.reference) {
@@ -378,8 +379,15 @@ export const panel = {
       },
       onClick(pick) {
         if (!visible || !pick || !meshes.reference || !meshes.source) return;
-        landmarks.click(pick.side, pick.welded ?? pick.vertex);
-        transfer.selected = -1;
+        const vertex = pick.welded ?? pick.vertex;
+        if (transfer.selected >= 0 && !landmarks.pending) {
+          // A selected pair: the click moves that side's end (the pair stays selected, so the
+          // other end can be moved next).
+          landmarks.move(transfer.selected, pick.side, vertex);
+        } else {
+          landmarks.click(pick.side, vertex);
+          transfer.selected = -1;
+        }
         refresh();
       },
     });
