@@ -733,6 +733,23 @@ it('edit: brush two handles and a fixed part, drag the gizmo, finalize; the save
   check(JSON.stringify({ ...spec, handles: spec.handles.map((h) => ({ select: h.select })) }) === JSON.stringify(edit.spec), 'the saved spec differs from the one the page created the session with');
   cliMatchesPage(restFile, specFile, raw, diagonal, 'translate');
 
+  // The worker dies with the session open: the page prepares the same edit in the new worker and
+  // brings its steps back — the same mesh, the same matrices, and undo below still goes to rest.
+  const recoveries = await page.evaluate(() => window.__meshmorph.state.recoveries || 0);
+  await page.evaluate(() => { window.__meshmorph.client.run('debugCrash').promise.catch(() => {}); });
+  await page.waitForFunction((n) => (window.__meshmorph.state.recoveries || 0) > n, recoveries, { timeout: 60000 });
+  await page.waitForFunction(() => window.__meshmorph.state.edit.restored >= 1 || window.__meshmorph.state.error, null, { timeout: 60000 });
+  await waitIdle(page);
+  const restoredEdit = await page.evaluate(() => JSON.parse(JSON.stringify(window.__meshmorph.state.edit)));
+  const restoredRaw = (await page.evaluate(() => window.__meshmorph.hooks.editPositions())).raw;
+  let restoreError = 0;
+  for (let i = 0; i < raw.length; ++i) restoreError = Math.max(restoreError, Math.abs(restoredRaw[i] - raw[i]));
+  console.log(`     edit session restored after a worker crash: ${(restoreError / diagonal).toExponential(2)}·diag from the mesh before`);
+  check(restoredEdit.session && restoredEdit.restored === 1 && JSON.stringify(restoredEdit.matrices) === JSON.stringify(edit.matrices),
+    `the edit session after the crash: ${JSON.stringify({ session: restoredEdit.session, restored: restoredEdit.restored, matrices: restoredEdit.matrices })}`);
+  check(restoreError <= 1e-9 * diagonal, `the restored session shows another mesh (${restoreError / diagonal}·diag)`);
+  check(restoredEdit.finalized === 1, `finalized ${restoredEdit.finalized} times after the restore`);
+
   // Undo goes back to the rest shape, redo to the edit.
   await page.click('#edit-undo');
   await waitFinalized(page, 2);

@@ -15,11 +15,16 @@ class NodeWorker {
   constructor(workerData) {
     this.thread = new Worker(workerUrl, { workerData });
     this.thread.on('message', (data) => this.onmessage?.({ data }));
-    this.thread.on('error', (e) => this.onerror?.({ message: e.message, preventDefault() {} }));
+    this.thread.on('error', (e) => {
+      const event = { message: e.message, defaultPrevented: false, preventDefault() { this.defaultPrevented = true; } };
+      this.onerror?.(event);
+      NodeWorker.errors.push(event);
+    });
   }
   postMessage(message, transfer) { this.thread.postMessage(message, transfer); }
   terminate() { this.thread.terminate(); }
 }
+NodeWorker.errors = []; // every error event given to a client, to check it was handled
 
 function makeClient(options = {}, workerData = {}) {
   let started = 0;
@@ -223,6 +228,9 @@ test('a worker that dies (uncaught error) is replaced and the mesh restored', as
     for (let i = 0; i < 100 && !restarts.length; ++i) await new Promise((resolve) => setTimeout(resolve, 50));
     assert.equal(restarts.length, 1, 'no restart after the worker died');
     assert.equal(restarts[0].code, 'Crashed');
+    // The client handled the error event: no uncaught error reaches the page (Firefox showed one).
+    const crash = NodeWorker.errors.find((e) => /debugCrash/.test(e.message));
+    assert.ok(crash && crash.defaultPrevented, 'the worker\'s error event was not marked handled (preventDefault)');
     const { info } = await client.run('validate', {}).promise;
     assert.equal(info.report.vertices, 14587);
   } finally {

@@ -97,7 +97,12 @@ export class MeshMorphClient {
           if (message.threads) this.threads = message.threads;
           if (message.note) this.onStatus(message.note);
           worker.onmessage = (e) => this.handle(worker, e.data);
-          worker.onerror = (e) => this.crashed(worker, e.message || 'worker error');
+          worker.onerror = (e) => {
+            // Handled here (a new worker, the page told): not also an uncaught error of the page
+            // (Firefox reports a worker's unhandled error on the page otherwise).
+            e.preventDefault?.();
+            this.crashed(worker, e.message || 'worker error');
+          };
           resolve(message);
         } else if (message.type === 'error') {
           reject(toMeshMorphError(message));

@@ -102,6 +102,14 @@ export class EditMoves {
     return this.settle(matrices);
   }
 
+  // The steps of a session whose worker was replaced, in the new session: the same history and
+  // place in it, settled there (nothing to settle at the first step, the rest shape).
+  async restore(history, at) {
+    this.history = history.map((matrices) => matrices.map((m) => m.slice()));
+    this.at = Math.min(Math.max(at, 0), this.history.length - 1);
+    return this.at === 0 ? true : this.settle(this.current);
+  }
+
   // Undo (-1) / redo (+1): returns the matrices now current, or null when there is no such step.
   async step(delta) {
     const index = this.at + delta;

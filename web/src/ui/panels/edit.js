@@ -94,6 +94,7 @@ export const panel = {
     const edit = {
       step: 0, handle: 0, handles: [0], active: 0, roi: 0, fixed: 0, session: false, matrices: [identity],
       drags: { sent: 0, answered: 0, first: 0, last: 0, roundTripMs: 0, applyMs: 0 }, finalized: 0, spec: null, saved: null,
+      restored: 0, // sessions brought back in a replaced worker
     };
     state.edit = edit;
 
@@ -348,7 +349,8 @@ export const panel = {
       if (radio) radio.checked = true;
     }
 
-    async function startSession(matrices = null) {
+    // spec: the session's spec (a restored session's); by default the current selection's.
+    async function startSession(matrices = null, sessionSpec = null) {
       if (!sets || !sets.counts().handle) {
         app.showError({ code: 'InvalidArgument', message: 'paint a handle first (step 1): the edit needs at least one handle vertex' });
         return false;
@@ -356,7 +358,7 @@ export const panel = {
       endSession({ restore: true });
       edit.active = sets.compact(edit.active);
       refresh();
-      const spec = currentSpec(null);
+      const spec = sessionSpec ?? currentSpec(null);
       const result = await app.runOp('Preparing the edit', 'editCreate', { spec });
       if (!result) return false;
       edit.spec = spec;
@@ -471,14 +473,28 @@ export const panel = {
       refresh();
     });
     app.on('mesh', (mesh) => newMesh(mesh));
-    // A replaced worker has the meshes again but not the edit session: back to the selection
-    // (the painted sets stay).
-    app.on('restarted', () => {
+    // A replaced worker has the meshes again but not the edit session: the same edit is prepared
+    // in it and its steps come back (the current one settled, undo / redo as they were). A
+    // session whose preparation was cancelled never started, so nothing comes back then.
+    app.on('restarted', async () => {
       if (!edit.session) return;
+      // Back to the last step that was settled: a step still settling may be what the cancel
+      // stopped, or what the worker died of.
+      const spec = edit.spec, history = moves.history, active = edit.active;
+      const settled = history.map((_, i) => i).filter((i) => sameMatrices(history[i], edit.matrices));
+      const at = settled.length ? settled.reduce((a, b) => (Math.abs(b - moves.at) < Math.abs(a - moves.at) ? b : a)) : 0;
       edit.session = false; // nothing to dispose in the new worker
       endSession();
       refresh();
       updateBrush();
+      edit.active = active;
+      if (!(await startSession(null, spec))) return;
+      if (!(await moves.restore(history, at))) return;
+      gizmo.setMatrix(moves.current[edit.active]);
+      edit.matrices = moves.current;
+      edit.restored += 1;
+      app.setStatus('editing: the session was prepared again in the new worker, with its steps');
+      refresh();
     });
     app.on('job', (job) => {
       const was = visible;
