@@ -842,12 +842,10 @@ async function visibleOnSide(page, side, key, count = 8) {
 }
 
 // A click with the real mouse at a vertex of a side: the first candidate where the hover pick
-// reports that side (a vertex on the silhouette can let the ray miss). Returns the vertex the
-// page picked (the pending half or the last pair) after checking it is under the pointer
-// (within 3 px).
-async function clickLandmark(page, side, candidates) {
-  const before = await transferState(page);
-  const count = before.pairs.length * 2 + (before.pending ? 1 : 0);
+// reports that side (a vertex on the silhouette can let the ray miss). `done(arg)` runs in the
+// page and says the click took effect; `picked(transfer state)` is the vertex the page chose,
+// checked to be under the pointer (within 3 px). `what` names the effect in errors.
+async function clickOnSide(page, side, candidates, { done, arg, picked, what }) {
   for (const target of candidates) {
     await page.mouse.move(target.x, target.y, { steps: 4 });
     const hovered = await page.waitForFunction((s) => document.getElementById('tr-hover').textContent.startsWith(s), side, { timeout: 1500 })
@@ -855,40 +853,39 @@ async function clickLandmark(page, side, candidates) {
     if (!hovered) continue;
     await page.mouse.down();
     await page.mouse.up();
-    await page.waitForFunction((n) => {
-      const t = window.__meshmorph.state.transfer;
-      return t.pairs.length * 2 + (t.pending ? 1 : 0) > n;
-    }, count, { timeout: 3000 }).catch(() => { throw new Error(`${side}: the click at vertex ${target.vertex} added no landmark`); });
-    const t = await transferState(page);
-    const picked = t.pending ? t.pending.vertex : t.pairs[t.pairs.length - 1][side === 'reference' ? 0 : 1];
-    const at = await page.evaluate(({ s, v }) => window.__meshmorph.hooks.transferVertexOnScreen(s, v), { s: side, v: picked });
-    check(Math.hypot(at.x - target.x, at.y - target.y) <= 3, `${side}: clicked at vertex ${target.vertex} (${target.x.toFixed(1)}, ${target.y.toFixed(1)}), picked ${picked} at (${at.x.toFixed(1)}, ${at.y.toFixed(1)})`);
-    return picked;
+    await page.waitForFunction(done, arg, { timeout: 3000 })
+      .catch(() => { throw new Error(`${side}: the click at vertex ${target.vertex} ${what}`); });
+    const vertex = picked(await transferState(page));
+    const at = await page.evaluate(({ s, v }) => window.__meshmorph.hooks.transferVertexOnScreen(s, v), { s: side, v: vertex });
+    check(Math.hypot(at.x - target.x, at.y - target.y) <= 3, `${side}: clicked at vertex ${target.vertex} (${target.x.toFixed(1)}, ${target.y.toFixed(1)}), picked ${vertex} at (${at.x.toFixed(1)}, ${at.y.toFixed(1)})`);
+    return vertex;
   }
   throw new Error(`${side}: no hover pick at any of the vertices ${candidates.map((c) => c.vertex).join(', ')}`);
 }
 
-// With pair `index` selected, a real click at a vertex of `side` moves that end of the pair
-// (candidates as for clickLandmark); returns the vertex the page put there after checking it is
-// under the pointer.
+// A new landmark half: returns the pending half or the completed pair's vertex on `side`.
+async function clickLandmark(page, side, candidates) {
+  const before = await transferState(page);
+  return clickOnSide(page, side, candidates, {
+    done: (n) => {
+      const t = window.__meshmorph.state.transfer;
+      return t.pairs.length * 2 + (t.pending ? 1 : 0) > n;
+    },
+    arg: before.pairs.length * 2 + (before.pending ? 1 : 0),
+    picked: (t) => (t.pending ? t.pending.vertex : t.pairs[t.pairs.length - 1][side === 'reference' ? 0 : 1]),
+    what: 'added no landmark',
+  });
+}
+
+// With pair `index` selected, a click on `side` moves that end of the pair; returns its new vertex.
 async function moveLandmark(page, side, index, candidates) {
   const k = side === 'reference' ? 0 : 1;
-  const before = (await transferState(page)).pairs[index][k];
-  for (const target of candidates) {
-    await page.mouse.move(target.x, target.y, { steps: 4 });
-    const hovered = await page.waitForFunction((s) => document.getElementById('tr-hover').textContent.startsWith(s), side, { timeout: 1500 })
-      .then(() => true, () => false);
-    if (!hovered) continue;
-    await page.mouse.down();
-    await page.mouse.up();
-    await page.waitForFunction(({ i, c, b }) => window.__meshmorph.state.transfer.pairs[i][c] !== b, { i: index, c: k, b: before }, { timeout: 3000 })
-      .catch(() => { throw new Error(`${side}: the click at vertex ${target.vertex} did not move pair ${index + 1}`); });
-    const picked = (await transferState(page)).pairs[index][k];
-    const at = await page.evaluate(({ s, v }) => window.__meshmorph.hooks.transferVertexOnScreen(s, v), { s: side, v: picked });
-    check(Math.hypot(at.x - target.x, at.y - target.y) <= 3, `${side}: moved to vertex ${target.vertex} (${target.x.toFixed(1)}, ${target.y.toFixed(1)}), picked ${picked} at (${at.x.toFixed(1)}, ${at.y.toFixed(1)})`);
-    return picked;
-  }
-  throw new Error(`${side}: no hover pick at any of the vertices ${candidates.map((c) => c.vertex).join(', ')}`);
+  return clickOnSide(page, side, candidates, {
+    done: ({ i, c, b }) => window.__meshmorph.state.transfer.pairs[i][c] !== b,
+    arg: { i: index, c: k, b: (await transferState(page)).pairs[index][k] },
+    picked: (t) => t.pairs[index][k],
+    what: `did not move pair ${index + 1}`,
+  });
 }
 
 const meanDistance = (a, b) => {
