@@ -7,6 +7,10 @@
 #include <limits>
 #include <queue>
 #include <string>
+#include <tuple>
+
+#include "mesh/topology.h"
+#include "mesh/weld.h"
 
 namespace mm {
 
@@ -43,6 +47,19 @@ struct CsGrid {
   }
   bool in(int x, int y, int z) const { return x >= 0 && y >= 0 && z >= 0 && x < nx && y < ny && z < nz; }
   size_t size() const { return size_t(nx) * ny * nz; }
+};
+
+// Steps the geodesic and the bands may not take: between cells owned by two parts whose contact
+// was cut (step 2b). Empty = none.
+struct CsCuts {
+  std::vector<int> own;      // per cell: owning part, -1 for none
+  std::vector<uint8_t> cut;  // np × np
+  int np = 0;
+  bool blocked(size_t i, size_t j) const {
+    if (own.empty()) return false;
+    const int a = own[i], b = own[j];
+    return a >= 0 && b >= 0 && cut[size_t(a) * np + b];
+  }
 };
 
 // Breadth-first layers (26-neighbourhood) from every cell with mask == from_value, up to
@@ -98,7 +115,7 @@ std::vector<float> cs_chamfer_depth(const CsGrid& g, const std::vector<uint8_t>&
 // Connected components (26-neighbourhood) of cells with label[i] == value... generalised:
 // cells with key[i] >= 0 join neighbours with the same key. Returns a component id per cell (-1
 // for key < 0) and the number of components; ids follow scan order.
-int cs_components(const CsGrid& g, const std::vector<int>& key, std::vector<int>* comp) {
+int cs_components(const CsGrid& g, const std::vector<int>& key, std::vector<int>* comp, const CsCuts* cuts = nullptr) {
   const auto& N = cs_neighbours();
   comp->assign(g.size(), -1);
   int n = 0;
@@ -116,12 +133,71 @@ int cs_components(const CsGrid& g, const std::vector<int>& key, std::vector<int>
         const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
         if (!g.in(a, b, c)) continue;
         const size_t j = g.idx(a, b, c);
-        if ((*comp)[j] < 0 && key[j] == key[i]) (*comp)[j] = n, stack.push_back(j);
+        if ((*comp)[j] < 0 && key[j] == key[i] && !(cuts && cuts->blocked(i, j))) (*comp)[j] = n, stack.push_back(j);
       }
     }
     ++n;
   }
   return n;
+}
+
+
+// Samples each triangle every ≤ h/3 and marks the cells the samples fall in (cell = floor((p − lo)
+// / h) − off, clamped to g): every cell the triangle crosses but for grazed corners, which the
+// closing seals.
+void cs_rasterize(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const std::vector<int>& faces, const Eigen::Vector3d& lo,
+                  double h, const int off[3], const CsGrid& g, std::vector<uint8_t>* surf) {
+  const int dims[3] = {g.nx, g.ny, g.nz};
+  auto cell_of = [&](const Eigen::RowVector3d& p, int k) {
+    return std::clamp(int(std::floor((p[k] - lo[k]) / h)) - off[k], 0, dims[k] - 1);
+  };
+  for (int f : faces) {
+    const Eigen::RowVector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    const double e = std::max({(b - a).norm(), (c - a).norm(), (c - b).norm()});
+    const int n = std::max(1, int(std::ceil(3 * e / h)));
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; i + j <= n; ++j) {
+        const Eigen::RowVector3d p = a + (double(i) / n) * (b - a) + (double(j) / n) * (c - a);
+        (*surf)[g.idx(cell_of(p, 0), cell_of(p, 1), cell_of(p, 2))] = 1;
+      }
+  }
+}
+
+// The solid a surface encloses on g (whose border cells must be empty): dilate the surface by
+// close_holes, flood the exterior from the border (6-neighbourhood), erode back; the surface
+// cells are solid too.
+std::vector<uint8_t> cs_fill_solid(const CsGrid& g, const std::vector<uint8_t>& surf, int close_holes) {
+  std::vector<uint8_t> wall = surf;
+  if (close_holes > 0) {
+    const std::vector<int> lay = cs_layers_from(g, surf, 1, close_holes);
+    for (size_t i = 0; i < g.size(); ++i) wall[i] = lay[i] <= close_holes;
+  }
+  std::vector<uint8_t> ext(g.size(), 0);
+  std::vector<size_t> stack;
+  for (size_t i = 0; i < g.size(); ++i) {
+    int x, y, z;
+    g.xyz(i, &x, &y, &z);
+    if ((x == 0 || y == 0 || z == 0 || x == g.nx - 1 || y == g.ny - 1 || z == g.nz - 1) && !wall[i])
+      ext[i] = 1, stack.push_back(i);
+  }
+  const int d6[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  while (!stack.empty()) {
+    const size_t i = stack.back();
+    stack.pop_back();
+    int x, y, z;
+    g.xyz(i, &x, &y, &z);
+    for (const auto& d : d6) {
+      const int a = x + d[0], b = y + d[1], c = z + d[2];
+      if (!g.in(a, b, c)) continue;
+      const size_t j = g.idx(a, b, c);
+      if (!ext[j] && !wall[j]) ext[j] = 1, stack.push_back(j);
+    }
+  }
+  std::vector<uint8_t> solid(g.size(), 0);
+  std::vector<int> lay;
+  if (close_holes > 0) lay = cs_layers_from(g, ext, 1, close_holes);
+  for (size_t i = 0; i < g.size(); ++i) solid[i] = surf[i] || (!ext[i] && (close_holes == 0 || lay[i] > close_holes));
+  return solid;
 }
 
 }  // namespace curve_skeleton_detail
@@ -200,60 +276,20 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
     vs.grid.dims[k] = dims[k];
   }
   vs.grid.cell = h;
-  auto cell_of = [&](const Eigen::RowVector3d& p, int k) {
-    return std::clamp(int(std::floor((p[k] - vs.grid.lo[k]) / h)), 0, dims[k] - 1);
-  };
+  const Eigen::Vector3d glo(vs.grid.lo[0], vs.grid.lo[1], vs.grid.lo[2]);
+  const int no_offset[3] = {0, 0, 0};
   std::vector<uint8_t> surf(g.size(), 0);
-  for (int f = 0; f < F.rows(); ++f) {
-    if ((f & 4095) == 0 && !progress.update("skeleton: voxels", 0.3 * f / F.rows())) return fail(StatusCode::Cancelled, "cancelled during skeleton: voxels");
-    const Eigen::RowVector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
-    const double e = std::max({(b - a).norm(), (c - a).norm(), (c - b).norm()});
-    // Samples every ≤ h/3 cover every cell the triangle crosses but for grazed corners, which the
-    // closing (close_holes) seals.
-    const int n = std::max(1, int(std::ceil(3 * e / h)));
-    for (int i = 0; i <= n; ++i)
-      for (int j = 0; i + j <= n; ++j) {
-        const Eigen::RowVector3d p = a + (double(i) / n) * (b - a) + (double(j) / n) * (c - a);
-        surf[g.idx(cell_of(p, 0), cell_of(p, 1), cell_of(p, 2))] = 1;
-      }
-  }
-  // Closing: dilate the surface by close_holes, flood the exterior, then erode back.
-  std::vector<uint8_t> wall = surf;
-  if (opt.close_holes > 0) {
-    const std::vector<int> lay = cs_layers_from(g, surf, 1, opt.close_holes);
-    for (size_t i = 0; i < g.size(); ++i) wall[i] = lay[i] <= opt.close_holes;
-  }
-  std::vector<uint8_t> ext(g.size(), 0);
   {
-    std::vector<size_t> stack;
-    for (size_t i = 0; i < g.size(); ++i) {
-      int x, y, z;
-      g.xyz(i, &x, &y, &z);
-      if ((x == 0 || y == 0 || z == 0 || x == g.nx - 1 || y == g.ny - 1 || z == g.nz - 1) && !wall[i])
-        ext[i] = 1, stack.push_back(i);
-    }
-    const int d6[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-    while (!stack.empty()) {
-      const size_t i = stack.back();
-      stack.pop_back();
-      int x, y, z;
-      g.xyz(i, &x, &y, &z);
-      for (const auto& d : d6) {
-        const int a = x + d[0], b = y + d[1], c = z + d[2];
-        if (!g.in(a, b, c)) continue;
-        const size_t j = g.idx(a, b, c);
-        if (!ext[j] && !wall[j]) ext[j] = 1, stack.push_back(j);
-      }
+    std::vector<int> chunk;
+    for (int f0 = 0; f0 < F.rows(); f0 += 4096) {
+      if (!progress.update("skeleton: voxels", 0.3 * f0 / F.rows())) return fail(StatusCode::Cancelled, "cancelled during skeleton: voxels");
+      chunk.clear();
+      for (int f = f0; f < std::min<int>(f0 + 4096, int(F.rows())); ++f) chunk.push_back(f);
+      cs_rasterize(V, F, chunk, glo, h, no_offset, g, &surf);
     }
   }
   std::vector<uint8_t>& solid = vs.solid;
-  solid.assign(g.size(), 0);
-  {
-    std::vector<int> lay;
-    if (opt.close_holes > 0) lay = cs_layers_from(g, ext, 1, opt.close_holes);
-    for (size_t i = 0; i < g.size(); ++i)
-      solid[i] = surf[i] || (!ext[i] && (opt.close_holes == 0 || lay[i] > opt.close_holes));
-  }
+  solid = cs_fill_solid(g, surf, opt.close_holes);
   if (!progress.update("skeleton: voxels", 0.4)) return fail(StatusCode::Cancelled, "cancelled during skeleton: voxels");
 
   // 2. Bridge separate parts to the largest one along the shortest path through empty cells.
@@ -295,6 +331,200 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
     ++out.num_bridges;
   }
   vs.depth = cs_chamfer_depth(g, solid);
+  // 2b. Parts that merely touch. A character built from separate parts (RobotExpressive: 63 once
+  // welded, KayKit: 14–15) has parts that interpenetrate at its joints and parts that only touch
+  // (a hanging forearm against the hip joint): the union solid then has a loop, and the Reeb graph
+  // of step 4 would cut it where the geodesic fronts meet — mid-limb — so the arm hangs from the
+  // hip. Each part's own solid is filled as in step 1; each solid cell gets an owner part; two
+  // parts' contact is kOverlapWeight × the cells both hold plus the neighbouring cells the one and
+  // the other own. A maximum spanning tree of the contacts keeps the strongest; a contact left out
+  // is cut — the geodesic and the bands may not step across it — when it closes a loop around a
+  // hole (see detour_exceeds), and kept where three parts meet at one joint.
+  CsCuts cuts;
+  {
+    // Parts: connected components once vertices at the same position are merged (glTF splits
+    // them at UV seams).
+    WeldOptions wo;
+    wo.tolerance = 0;
+    wo.drop_degenerate_faces = false;
+    const WeldResult welded = weld_vertices(V, F, wo);
+    int nvc = 0;
+    const Eigen::VectorXi vc = vertex_components(welded.F, int(welded.V.rows()), &nvc);
+    std::vector<int> part_id(nvc, -1);
+    std::vector<std::vector<int>> part_faces;
+    for (int f = 0; f < F.rows(); ++f) {
+      const int c = vc[welded.to_welded[F(f, 0)]];
+      if (part_id[c] < 0) part_id[c] = int(part_faces.size()), part_faces.emplace_back();
+      part_faces[part_id[c]].push_back(f);
+    }
+    const int np = int(part_faces.size());
+    if (np >= 3 && np <= 64) {
+      std::vector<uint64_t> mask(g.size(), 0);
+      for (int p = 0; p < np; ++p) {
+        if (!progress.update("skeleton: parts", 0.4 + 0.05 * p / np)) return fail(StatusCode::Cancelled, "cancelled during skeleton: parts");
+        Eigen::Vector3d plo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), phi = -plo;
+        for (int f : part_faces[p])
+          for (int k = 0; k < 3; ++k) {
+            plo = plo.cwiseMin(V.row(F(f, k)).transpose());
+            phi = phi.cwiseMax(V.row(F(f, k)).transpose());
+          }
+        int off[3], n[3];
+        for (int k = 0; k < 3; ++k) {
+          off[k] = std::max(0, int(std::floor((plo[k] - glo[k]) / h)) - pad);
+          n[k] = std::min(dims[k] - 1, int(std::floor((phi[k] - glo[k]) / h)) + pad) - off[k] + 1;
+        }
+        const CsGrid sub{n[0], n[1], n[2]};
+        std::vector<uint8_t> ps(sub.size(), 0);
+        cs_rasterize(V, F, part_faces[p], glo, h, off, sub, &ps);
+        ps = cs_fill_solid(sub, ps, opt.close_holes);
+        for (size_t i = 0; i < sub.size(); ++i) {
+          if (!ps[i]) continue;
+          int x, y, z;
+          sub.xyz(i, &x, &y, &z);
+          const size_t j = g.idx(x + off[0], y + off[1], z + off[2]);
+          if (solid[j]) mask[j] |= uint64_t(1) << p;
+        }
+      }
+      // Owner of each solid cell: the lowest part holding it; cells of no part (gaps the closing
+      // filled, bridges) take the part that reaches them first, breadth-first in scan order.
+      cuts.own.assign(g.size(), -1);
+      {
+        std::deque<size_t> q;
+        for (size_t i = 0; i < g.size(); ++i)
+          if (mask[i]) cuts.own[i] = __builtin_ctzll(mask[i]), q.push_back(i);
+        const auto& N = cs_neighbours();
+        while (!q.empty()) {
+          const size_t i = q.front();
+          q.pop_front();
+          int x, y, z;
+          g.xyz(i, &x, &y, &z);
+          for (int k = 0; k < 26; ++k) {
+            const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
+            if (!g.in(a, b, c)) continue;
+            const size_t j = g.idx(a, b, c);
+            if (solid[j] && cuts.own[j] < 0) cuts.own[j] = cuts.own[i], q.push_back(j);
+          }
+        }
+      }
+      // Contact of two parts: cells both hold (interpenetration, weighted kOverlapWeight) plus
+      // neighbouring cells owned by one and the other (touch, or a gap the closing filled).
+      constexpr int64_t kOverlapWeight = 4;
+      std::vector<int64_t> overlap(size_t(np) * np, 0), touch(size_t(np) * np, 0);
+      {
+        const auto& N = cs_neighbours();
+        for (size_t i = 0; i < g.size(); ++i) {
+          const uint64_t m = mask[i];
+          if (m & (m - 1))
+            for (int a = 0; a < np; ++a)
+              if (m >> a & 1)
+                for (int b = a + 1; b < np; ++b)
+                  if (m >> b & 1) ++overlap[size_t(a) * np + b];
+          if (cuts.own[i] < 0) continue;
+          int x, y, z;
+          g.xyz(i, &x, &y, &z);
+          for (int k = 13; k < 26; ++k) {  // each unordered pair of cells once
+            const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
+            if (!g.in(a, b, c)) continue;
+            const int oi = cuts.own[i], oj = cuts.own[g.idx(a, b, c)];
+            if (oj >= 0 && oj != oi) ++touch[size_t(std::min(oi, oj)) * np + std::max(oi, oj)];
+          }
+        }
+      }
+      // Kruskal, strongest contact first (ties: lower part indices); every pair of parts not
+      // joined by the tree is cut.
+      std::vector<std::tuple<int64_t, int, int>> edges;
+      for (int a = 0; a < np; ++a)
+        for (int b = a + 1; b < np; ++b) {
+          const int64_t w = kOverlapWeight * overlap[size_t(a) * np + b] + touch[size_t(a) * np + b];
+          if (w > 0) edges.emplace_back(-w, a, b);
+        }
+      std::sort(edges.begin(), edges.end());
+      std::vector<int> uf(np);
+      for (int p = 0; p < np; ++p) uf[p] = p;
+      std::function<int(int)> find = [&](int p) { return uf[p] == p ? p : uf[p] = find(uf[p]); };
+      cuts.cut.assign(size_t(np) * np, 1);
+      cuts.np = np;
+      for (int p = 0; p < np; ++p) cuts.cut[size_t(p) * np + p] = 0;
+      // A contact left out of the tree is cut only where it closes a loop around a hole (a forearm
+      // against the hip): the shortest way from one side of the contact to the other without
+      // crossing it is longer than kLoopDetour times the solid's depth there (+ kLoopSlack cells).
+      // Where three parts meet at one joint (an arm, the body and a large head), the way round
+      // through the third part is short, and the contact stays.
+      constexpr double kLoopDetour = 3.0, kLoopSlack = 6.0;
+      const auto& N = cs_neighbours();
+      std::vector<double> dist(g.size(), std::numeric_limits<double>::infinity());
+      std::vector<size_t> touched;
+      auto detour_exceeds = [&](int a, int b) {
+        auto is_side = [&](size_t i, int self, int other) {
+          if (cuts.own[i] != self) return false;
+          int x, y, z;
+          g.xyz(i, &x, &y, &z);
+          for (int k = 0; k < 26; ++k) {
+            const int u = x + N.d[k][0], v = y + N.d[k][1], w = z + N.d[k][2];
+            if (g.in(u, v, w) && cuts.own[g.idx(u, v, w)] == other) return true;
+          }
+          return false;
+        };
+        using Item = std::pair<double, size_t>;
+        std::priority_queue<Item, std::vector<Item>, std::greater<Item>> pq;
+        float depth_max = 0;
+        bool b_faces = false;
+        for (size_t i = 0; i < g.size(); ++i)
+          if (is_side(i, a, b)) dist[i] = 0, touched.push_back(i), pq.push({0, i}), depth_max = std::max(depth_max, vs.depth[i]);
+          else if (is_side(i, b, a)) depth_max = std::max(depth_max, vs.depth[i]), b_faces = true;
+        if (pq.empty() || !b_faces) {  // no cell of a faces b, or none of b faces a: no step to block
+          for (size_t i : touched) dist[i] = std::numeric_limits<double>::infinity();
+          touched.clear();
+          return false;
+        }
+        const double limit = kLoopDetour * depth_max + kLoopSlack;
+        bool reached = false;
+        while (!pq.empty() && !reached) {
+          const auto [d, i] = pq.top();
+          pq.pop();
+          if (d > dist[i]) continue;
+          if (d > limit) break;
+          if (cuts.own[i] == b) reached = is_side(i, b, a);
+          int x, y, z;
+          g.xyz(i, &x, &y, &z);
+          for (int k = 0; k < 26; ++k) {
+            const int u = x + N.d[k][0], v = y + N.d[k][1], w = z + N.d[k][2];
+            if (!g.in(u, v, w)) continue;
+            const size_t j = g.idx(u, v, w);
+            if (!solid[j]) continue;
+            if (cuts.blocked(i, j)) continue;
+            const double nd = d + N.w[k];
+            if (nd < dist[j]) {
+              if (std::isinf(dist[j])) touched.push_back(j);
+              dist[j] = nd, pq.push({nd, j});
+            }
+          }
+        }
+        for (size_t i : touched) dist[i] = std::numeric_limits<double>::infinity();
+        touched.clear();
+        return !reached;
+      };
+      std::vector<uint8_t> in_tree(edges.size(), 0);
+      for (size_t e = 0; e < edges.size(); ++e) {
+        const auto& [negw, a, b] = edges[e];
+        const int ra = find(a), rb = find(b);
+        if (ra == rb) continue;
+        uf[std::max(ra, rb)] = std::min(ra, rb);
+        in_tree[e] = 1;
+        cuts.cut[size_t(a) * np + b] = cuts.cut[size_t(b) * np + a] = 0;
+      }
+      // Each left-out contact is measured against the tree alone (every other one blocked).
+      std::vector<uint8_t> keep(edges.size(), 0);
+      for (size_t e = 0; e < edges.size(); ++e)
+        if (!in_tree[e]) keep[e] = !detour_exceeds(std::get<1>(edges[e]), std::get<2>(edges[e]));
+      for (size_t e = 0; e < edges.size(); ++e) {
+        const auto& [negw, a, b] = edges[e];
+        if (keep[e]) cuts.cut[size_t(a) * np + b] = cuts.cut[size_t(b) * np + a] = 0;
+        if (!in_tree[e] && !keep[e]) ++out.num_cut_contacts;
+      }
+      if (out.num_cut_contacts == 0) cuts = CsCuts();
+    }
+  }
   size_t n_solid = 0;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (size_t i = 0; i < g.size(); ++i)
@@ -330,7 +560,7 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
         const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
         if (!g.in(a, b, c)) continue;
         const size_t j = g.idx(a, b, c);
-        if (!solid[j]) continue;
+        if (!solid[j] || cuts.blocked(i, j)) continue;
         const double nd = d + N.w[k];
         if (nd < geo[j]) geo[j] = nd, pq.push({nd, j});
       }
@@ -343,7 +573,7 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   for (size_t i = 0; i < g.size(); ++i)
     if (solid[i] && std::isfinite(geo[i])) band[i] = int(geo[i] / opt.band_width);
   std::vector<int> comp;
-  const int nn = cs_components(g, band, &comp);
+  const int nn = cs_components(g, band, &comp, &cuts);
   std::vector<Eigen::Vector3d> sum(nn, Eigen::Vector3d::Zero());
   std::vector<int> cnt(nn, 0), node_band(nn, 0);
   std::vector<float> rmax(nn, 0.f);
@@ -367,7 +597,7 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
         const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
         if (!g.in(a, b, c)) continue;
         const size_t j = g.idx(a, b, c);
-        if (comp[j] < 0 || band[j] != band[i] - 1) continue;
+        if (comp[j] < 0 || band[j] != band[i] - 1 || cuts.blocked(i, j)) continue;
         auto& v = contacts[comp[i]];
         auto it = std::find_if(v.begin(), v.end(), [&](const std::pair<int, int>& e) { return e.first == comp[j]; });
         if (it == v.end()) v.push_back({comp[j], 1});
@@ -396,6 +626,7 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   for (int c = 0; c < nn; ++c)
     if (par[c] >= 0) kids[par[c]].push_back(c);
   std::vector<double> reach(nn, 0.0);  // longest path length from the node down to a leaf of its subtree
+  std::vector<double> greach(nn, 0.0); // ... in geodesic bands × band width
   std::vector<uint8_t> alive(nn, 1);
   const double prune = opt.prune_length * L;
   std::function<void(int)> kill = [&](int c) {
@@ -416,16 +647,20 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
     // surface, where a blocky part's corners split off, has a small own depth but sits in a thick part).
     const double r_here = std::max<double>(rmax[c] + 0.5, vs.depth[vs.grid.index(vs.grid.coord(pos[c][0], 0), vs.grid.coord(pos[c][1], 1),
                                                                           vs.grid.coord(pos[c][2], 2))]) * h;
-    double kept = 0;
+    // A side branch's length is also measured along the geodesic (bands × band width): where a
+    // wide part's shell breaks up at small bumps (a robot head's bolts), the fragment's centroid
+    // lies far from its parent ring's, though it spans only a band or two.
+    double kept = 0, gkept = 0;
     for (int k : kids[c]) {
-      const double len = reach[k] + (pos[k] - pos[c]).norm();
+      const double len = reach[k] + (pos[k] - pos[c]).norm(), glen = greach[k] + opt.band_width * h;
       const bool split = kids[c].size() >= 2, side = k != keep;
-      if (split && ((side && len < std::max(prune, opt.prune_radius * r_here)) || (!side && len < opt.prune_radius * r_here)))
+      if (split && ((side && std::min(len, glen) < std::max(prune, opt.prune_radius * r_here)) || (!side && len < opt.prune_radius * r_here)))
         kill(k);
-      else kept = std::max(kept, len);
+      else kept = std::max(kept, len), gkept = std::max(gkept, glen);
     }
     (void)longest;
     reach[c] = kept;
+    greach[c] = gkept;
   }
   // The root's side branches: the root is usually mid-body, so its shortest remaining branch
   // can also be a stub; the rule above handles it as for any junction.

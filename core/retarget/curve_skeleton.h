@@ -12,6 +12,9 @@
 //     the solid is every cell the exterior flood does not reach (the union of all parts);
 //  2. separate solid components (parts with gaps between them) are bridged along the shortest
 //     path through empty cells, so the solid is one connected volume;
+//  2b. where separate mesh parts only touch and so close a loop around a hole (a hanging forearm
+//     against the hip), the geodesic may not step across the touch (a maximum spanning tree of the
+//     parts' contacts decides which touches close loops);
 //  3. geodesic distance inside the solid from a seed cell (nearest the solid's centroid), by
 //     Dijkstra on the 26-neighbourhood (weights 1, √2, √3);
 //  4. cells are cut into bands of `band_width` cells of geodesic distance; each connected
@@ -20,7 +23,9 @@
 //     (the Reeb graph's tree: every component of band k > 0 touches band k − 1 because a
 //     Dijkstra step is ≤ √3 < band_width);
 //  5. leaf branches shorter than prune_length or than the local radius are removed (salience as in
-//     Au et al. 2008's pruning of short branches), and chain nodes are smoothed.
+//     Au et al. 2008's pruning of short branches; a side branch's length is the smaller of its
+//     path through the node centroids and its geodesic extent in bands, so the fragments a wide
+//     part's shell breaks into at small bumps go too), and chain nodes are smoothed.
 //
 // V #V by 3, F #F by 3 (any triangle soup). Status: InvalidMesh when the mesh is empty, has
 // non-finite coordinates or out-of-range indices, is flat, or gives too few solid cells;
@@ -69,6 +74,7 @@ struct CurveSkeleton {
   int root = 0;
   VoxelSolid volume;            // the solid the skeleton was extracted from
   int num_bridges = 0;          // separate parts joined by a bridge (step 2)
+  int num_cut_contacts = 0;     // contacts between parts left out of the skeleton (step 2b)
 
   int size() const { return static_cast<int>(parent.size()); }
   // Neighbours of each node (parent and children), ascending.
