@@ -49,6 +49,19 @@ struct CsGrid {
   size_t size() const { return size_t(nx) * ny * nz; }
 };
 
+// Calls visit(j, k) for each neighbour j of cell i inside g, neighbours k0 ≤ k < k1 in the order
+// of cs_neighbours(); visit returns false to stop.
+template <class Visit>
+void cs_for_neighbours(const CsGrid& g, size_t i, Visit&& visit, int k0 = 0, int k1 = 26) {
+  const auto& N = cs_neighbours();
+  int x, y, z;
+  g.xyz(i, &x, &y, &z);
+  for (int k = k0; k < k1; ++k) {
+    const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
+    if (g.in(a, b, c) && !visit(g.idx(a, b, c), k)) return;
+  }
+}
+
 // Steps the geodesic and the bands may not take: between cells owned by two parts whose contact
 // was cut (step 2b). Empty = none.
 struct CsCuts {
@@ -65,7 +78,6 @@ struct CsCuts {
 // Breadth-first layers (26-neighbourhood) from every cell with mask == from_value, up to
 // max_layers; returns the layer of each cell (max_layers + 1 beyond).
 std::vector<int> cs_layers_from(const CsGrid& g, const std::vector<uint8_t>& mask, uint8_t from_value, int max_layers) {
-  const auto& N = cs_neighbours();
   std::vector<int> layer(g.size(), max_layers + 1);
   std::deque<size_t> q;
   for (size_t i = 0; i < g.size(); ++i)
@@ -74,14 +86,10 @@ std::vector<int> cs_layers_from(const CsGrid& g, const std::vector<uint8_t>& mas
     const size_t i = q.front();
     q.pop_front();
     if (layer[i] >= max_layers) continue;
-    int x, y, z;
-    g.xyz(i, &x, &y, &z);
-    for (int k = 0; k < 26; ++k) {
-      const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
-      if (!g.in(a, b, c)) continue;
-      const size_t j = g.idx(a, b, c);
+    cs_for_neighbours(g, i, [&](size_t j, int) {
       if (layer[j] > layer[i] + 1) layer[j] = layer[i] + 1, q.push_back(j);
-    }
+      return true;
+    });
   }
   return layer;
 }
@@ -116,7 +124,6 @@ std::vector<float> cs_chamfer_depth(const CsGrid& g, const std::vector<uint8_t>&
 // cells with key[i] >= 0 join neighbours with the same key. Returns a component id per cell (-1
 // for key < 0) and the number of components; ids follow scan order.
 int cs_components(const CsGrid& g, const std::vector<int>& key, std::vector<int>* comp, const CsCuts* cuts = nullptr) {
-  const auto& N = cs_neighbours();
   comp->assign(g.size(), -1);
   int n = 0;
   std::vector<size_t> stack;
@@ -127,14 +134,10 @@ int cs_components(const CsGrid& g, const std::vector<int>& key, std::vector<int>
     while (!stack.empty()) {
       const size_t i = stack.back();
       stack.pop_back();
-      int x, y, z;
-      g.xyz(i, &x, &y, &z);
-      for (int k = 0; k < 26; ++k) {
-        const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
-        if (!g.in(a, b, c)) continue;
-        const size_t j = g.idx(a, b, c);
+      cs_for_neighbours(g, i, [&](size_t j, int) {
         if ((*comp)[j] < 0 && key[j] == key[i] && !(cuts && cuts->blocked(i, j))) (*comp)[j] = n, stack.push_back(j);
-      }
+        return true;
+      });
     }
     ++n;
   }
@@ -310,21 +313,16 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
     for (size_t i = 0; i < g.size(); ++i)
       if (comp[i] == main) pred[i] = -1, q.push_back(i);
     int64_t hit = -1;
-    const auto& N = cs_neighbours();
     while (!q.empty() && hit < 0) {
       const size_t i = q.front();
       q.pop_front();
-      int x, y, z;
-      g.xyz(i, &x, &y, &z);
-      for (int k = 0; k < 26 && hit < 0; ++k) {
-        const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
-        if (!g.in(a, b, c)) continue;
-        const size_t j = g.idx(a, b, c);
-        if (pred[j] != -2) continue;
+      cs_for_neighbours(g, i, [&](size_t j, int) {
+        if (pred[j] != -2) return true;
         pred[j] = int64_t(i);
         if (comp[j] >= 0) hit = int64_t(j);
         else q.push_back(j);
-      }
+        return hit < 0;
+      });
     }
     if (hit < 0) break;
     for (int64_t i = pred[hit]; i >= 0 && comp[i] != main; i = pred[i]) solid[i] = 1;
@@ -392,18 +390,13 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
         std::deque<size_t> q;
         for (size_t i = 0; i < g.size(); ++i)
           if (mask[i]) cuts.own[i] = __builtin_ctzll(mask[i]), q.push_back(i);
-        const auto& N = cs_neighbours();
         while (!q.empty()) {
           const size_t i = q.front();
           q.pop_front();
-          int x, y, z;
-          g.xyz(i, &x, &y, &z);
-          for (int k = 0; k < 26; ++k) {
-            const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
-            if (!g.in(a, b, c)) continue;
-            const size_t j = g.idx(a, b, c);
+          cs_for_neighbours(g, i, [&](size_t j, int) {
             if (solid[j] && cuts.own[j] < 0) cuts.own[j] = cuts.own[i], q.push_back(j);
-          }
+            return true;
+          });
         }
       }
       // Contact of two parts: cells both hold (interpenetration, weighted kOverlapWeight) plus
@@ -411,7 +404,6 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
       constexpr int64_t kOverlapWeight = 4;
       std::vector<int64_t> overlap(size_t(np) * np, 0), touch(size_t(np) * np, 0);
       {
-        const auto& N = cs_neighbours();
         for (size_t i = 0; i < g.size(); ++i) {
           const uint64_t m = mask[i];
           if (m & (m - 1))
@@ -420,14 +412,11 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                 for (int b = a + 1; b < np; ++b)
                   if (m >> b & 1) ++overlap[size_t(a) * np + b];
           if (cuts.own[i] < 0) continue;
-          int x, y, z;
-          g.xyz(i, &x, &y, &z);
-          for (int k = 13; k < 26; ++k) {  // each unordered pair of cells once
-            const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
-            if (!g.in(a, b, c)) continue;
-            const int oi = cuts.own[i], oj = cuts.own[g.idx(a, b, c)];
+          cs_for_neighbours(g, i, [&](size_t j, int) {
+            const int oi = cuts.own[i], oj = cuts.own[j];
             if (oj >= 0 && oj != oi) ++touch[size_t(std::min(oi, oj)) * np + std::max(oi, oj)];
-          }
+            return true;
+          }, 13, 26);  // each unordered pair of cells once
         }
       }
       // Kruskal, strongest contact first (ties: lower part indices); every pair of parts not
@@ -457,13 +446,9 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
       auto detour_exceeds = [&](int a, int b) {
         auto is_side = [&](size_t i, int self, int other) {
           if (cuts.own[i] != self) return false;
-          int x, y, z;
-          g.xyz(i, &x, &y, &z);
-          for (int k = 0; k < 26; ++k) {
-            const int u = x + N.d[k][0], v = y + N.d[k][1], w = z + N.d[k][2];
-            if (g.in(u, v, w) && cuts.own[g.idx(u, v, w)] == other) return true;
-          }
-          return false;
+          bool faces = false;
+          cs_for_neighbours(g, i, [&](size_t j, int) { return !(faces = cuts.own[j] == other); });
+          return faces;
         };
         using Item = std::pair<double, size_t>;
         std::priority_queue<Item, std::vector<Item>, std::greater<Item>> pq;
@@ -485,20 +470,15 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
           if (d > dist[i]) continue;
           if (d > limit) break;
           if (cuts.own[i] == b) reached = is_side(i, b, a);
-          int x, y, z;
-          g.xyz(i, &x, &y, &z);
-          for (int k = 0; k < 26; ++k) {
-            const int u = x + N.d[k][0], v = y + N.d[k][1], w = z + N.d[k][2];
-            if (!g.in(u, v, w)) continue;
-            const size_t j = g.idx(u, v, w);
-            if (!solid[j]) continue;
-            if (cuts.blocked(i, j)) continue;
+          cs_for_neighbours(g, i, [&](size_t j, int k) {
+            if (!solid[j] || cuts.blocked(i, j)) return true;
             const double nd = d + N.w[k];
             if (nd < dist[j]) {
               if (std::isinf(dist[j])) touched.push_back(j);
               dist[j] = nd, pq.push({nd, j});
             }
-          }
+            return true;
+          });
         }
         for (size_t i : touched) dist[i] = std::numeric_limits<double>::infinity();
         touched.clear();
@@ -554,16 +534,12 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
       const auto [d, i] = pq.top();
       pq.pop();
       if (d > geo[i]) continue;
-      int x, y, z;
-      g.xyz(i, &x, &y, &z);
-      for (int k = 0; k < 26; ++k) {
-        const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
-        if (!g.in(a, b, c)) continue;
-        const size_t j = g.idx(a, b, c);
-        if (!solid[j] || cuts.blocked(i, j)) continue;
+      cs_for_neighbours(g, i, [&](size_t j, int k) {
+        if (!solid[j] || cuts.blocked(i, j)) return true;
         const double nd = d + N.w[k];
         if (nd < geo[j]) geo[j] = nd, pq.push({nd, j});
-      }
+        return true;
+      });
     }
   }
   if (!progress.update("skeleton: bands", 0.75)) return fail(StatusCode::Cancelled, "cancelled during skeleton: bands");
@@ -587,23 +563,16 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   }
   // Contacts between components of consecutive bands: parent = the lower-band component with most contacts.
   std::vector<std::vector<std::pair<int, int>>> contacts(nn);  // (lower component, count)
-  {
-    const auto& N = cs_neighbours();
-    for (size_t i = 0; i < g.size(); ++i) {
-      if (comp[i] < 0) continue;
-      int x, y, z;
-      g.xyz(i, &x, &y, &z);
-      for (int k = 0; k < 26; ++k) {
-        const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
-        if (!g.in(a, b, c)) continue;
-        const size_t j = g.idx(a, b, c);
-        if (comp[j] < 0 || band[j] != band[i] - 1 || cuts.blocked(i, j)) continue;
-        auto& v = contacts[comp[i]];
-        auto it = std::find_if(v.begin(), v.end(), [&](const std::pair<int, int>& e) { return e.first == comp[j]; });
-        if (it == v.end()) v.push_back({comp[j], 1});
-        else ++it->second;
-      }
-    }
+  for (size_t i = 0; i < g.size(); ++i) {
+    if (comp[i] < 0) continue;
+    cs_for_neighbours(g, i, [&](size_t j, int) {
+      if (comp[j] < 0 || band[j] != band[i] - 1 || cuts.blocked(i, j)) return true;
+      auto& v = contacts[comp[i]];
+      auto it = std::find_if(v.begin(), v.end(), [&](const std::pair<int, int>& e) { return e.first == comp[j]; });
+      if (it == v.end()) v.push_back({comp[j], 1});
+      else ++it->second;
+      return true;
+    });
   }
   std::vector<int> par(nn, -1);
   const int root = comp[seed];
