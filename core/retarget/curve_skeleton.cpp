@@ -465,7 +465,8 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
         const double limit = kLoopDetour * depth_max + kLoopSlack;
         bool reached = false;
         while (!pq.empty() && !reached) {
-          const auto [d, i] = pq.top();
+          const double d = pq.top().first;
+          const size_t i = pq.top().second;
           pq.pop();
           if (d > dist[i]) continue;
           if (d > limit) break;
@@ -531,7 +532,8 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
     geo[seed] = 0;
     pq.push({0, seed});
     while (!pq.empty()) {
-      const auto [d, i] = pq.top();
+      const double d = pq.top().first;
+      const size_t i = pq.top().second;
       pq.pop();
       if (d > geo[i]) continue;
       cs_for_neighbours(g, i, [&](size_t j, int k) {
