@@ -278,8 +278,13 @@ export function registerRetargetTests(it, { check, shot, nextFrame, waitIdle, ca
     });
     const fewer = await waitRun(page);
     check(Math.abs(fewer.run.frames - Math.ceil(done.run.frames / 2)) <= 1, `fps 15: ${fewer.run.frames} frames vs ${done.run.frames} at 30`);
+    // Back to 30: wait for the new run to start first (else waitRun could see the 15 fps run's
+    // "done" and then find the new run preparing: "the run failed: undefined", the thirty-second
+    // session's fresh clone).
+    const runs15 = (await rtState(page)).runs;
     await page.fill('#opt-fps', '30');
     await page.click('section.retarget h2'); // the field loses focus: lil-gui's finish-change
+    await page.waitForFunction((n) => window.__meshmorph.state.retarget.runs > n, runs15, { timeout: 10000 });
     await waitRun(page);
 
     // A source whose skeleton the woman's joints were not placed for: the page says so.
