@@ -75,6 +75,37 @@ struct CsCuts {
   }
 };
 
+// Dijkstra inside the solid (26-neighbourhood, weights 1, √2, √3) from `sources` (their *dist
+// already 0), never stepping where `cuts` block. Cells are settled in order of distance;
+// settle(i) returning true ends the search and returns true. Nothing beyond `limit` is settled.
+// *dist is lowered; cells first reached are appended to *touched when it is given.
+template <class Settle>
+bool cs_dijkstra(const CsGrid& g, const std::vector<uint8_t>& solid, const CsCuts& cuts, const std::vector<size_t>& sources,
+                 double limit, std::vector<double>* dist, std::vector<size_t>* touched, Settle&& settle) {
+  const auto& N = cs_neighbours();
+  using Item = std::pair<double, size_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> pq;
+  for (size_t i : sources) pq.push({0, i});
+  while (!pq.empty()) {
+    const double d = pq.top().first;
+    const size_t i = pq.top().second;
+    pq.pop();
+    if (d > (*dist)[i]) continue;
+    if (d > limit) break;
+    if (settle(i)) return true;
+    cs_for_neighbours(g, i, [&](size_t j, int k) {
+      if (!solid[j] || cuts.blocked(i, j)) return true;
+      const double nd = d + N.w[k];
+      if (nd < (*dist)[j]) {
+        if (touched && std::isinf((*dist)[j])) touched->push_back(j);
+        (*dist)[j] = nd, pq.push({nd, j});
+      }
+      return true;
+    });
+  }
+  return false;
+}
+
 // Breadth-first layers (26-neighbourhood) from every cell with mask == from_value, up to
 // max_layers; returns the layer of each cell (max_layers + 1 beyond).
 std::vector<int> cs_layers_from(const CsGrid& g, const std::vector<uint8_t>& mask, uint8_t from_value, int max_layers) {
@@ -440,7 +471,6 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
       // Where three parts meet at one joint (an arm, the body and a large head), the way round
       // through the third part is short, and the contact stays.
       constexpr double kLoopDetour = 3.0, kLoopSlack = 6.0;
-      const auto& N = cs_neighbours();
       std::vector<double> dist(g.size(), std::numeric_limits<double>::infinity());
       std::vector<size_t> touched;
       auto detour_exceeds = [&](int a, int b) {
@@ -450,37 +480,16 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
           cs_for_neighbours(g, i, [&](size_t j, int) { return !(faces = cuts.own[j] == other); });
           return faces;
         };
-        using Item = std::pair<double, size_t>;
-        std::priority_queue<Item, std::vector<Item>, std::greater<Item>> pq;
         float depth_max = 0;
         bool b_faces = false;
         for (size_t i = 0; i < g.size(); ++i)
-          if (is_side(i, a, b)) dist[i] = 0, touched.push_back(i), pq.push({0, i}), depth_max = std::max(depth_max, vs.depth[i]);
+          if (is_side(i, a, b)) dist[i] = 0, touched.push_back(i), depth_max = std::max(depth_max, vs.depth[i]);
           else if (is_side(i, b, a)) depth_max = std::max(depth_max, vs.depth[i]), b_faces = true;
-        if (pq.empty() || !b_faces) {  // no cell of a faces b, or none of b faces a: no step to block
-          for (size_t i : touched) dist[i] = std::numeric_limits<double>::infinity();
-          touched.clear();
-          return false;
-        }
-        const double limit = kLoopDetour * depth_max + kLoopSlack;
-        bool reached = false;
-        while (!pq.empty() && !reached) {
-          const double d = pq.top().first;
-          const size_t i = pq.top().second;
-          pq.pop();
-          if (d > dist[i]) continue;
-          if (d > limit) break;
-          if (cuts.own[i] == b) reached = is_side(i, b, a);
-          cs_for_neighbours(g, i, [&](size_t j, int k) {
-            if (!solid[j] || cuts.blocked(i, j)) return true;
-            const double nd = d + N.w[k];
-            if (nd < dist[j]) {
-              if (std::isinf(dist[j])) touched.push_back(j);
-              dist[j] = nd, pq.push({nd, j});
-            }
-            return true;
-          });
-        }
+        const std::vector<size_t> sources = touched;
+        // No cell of a faces b, or none of b faces a: no step to block.
+        const bool reached = sources.empty() || !b_faces ||
+                             cs_dijkstra(g, solid, cuts, sources, kLoopDetour * depth_max + kLoopSlack, &dist, &touched,
+                                         [&](size_t i) { return cuts.own[i] == b && is_side(i, b, a); });
         for (size_t i : touched) dist[i] = std::numeric_limits<double>::infinity();
         touched.clear();
         return !reached;
@@ -525,25 +534,8 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
       if (d < best) best = d, seed = i;
     }
   std::vector<double> geo(g.size(), std::numeric_limits<double>::infinity());
-  {
-    const auto& N = cs_neighbours();
-    using Item = std::pair<double, size_t>;
-    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> pq;
-    geo[seed] = 0;
-    pq.push({0, seed});
-    while (!pq.empty()) {
-      const double d = pq.top().first;
-      const size_t i = pq.top().second;
-      pq.pop();
-      if (d > geo[i]) continue;
-      cs_for_neighbours(g, i, [&](size_t j, int k) {
-        if (!solid[j] || cuts.blocked(i, j)) return true;
-        const double nd = d + N.w[k];
-        if (nd < geo[j]) geo[j] = nd, pq.push({nd, j});
-        return true;
-      });
-    }
-  }
+  geo[seed] = 0;
+  cs_dijkstra(g, solid, cuts, {seed}, std::numeric_limits<double>::infinity(), &geo, nullptr, [](size_t) { return false; });
   if (!progress.update("skeleton: bands", 0.75)) return fail(StatusCode::Cancelled, "cancelled during skeleton: bands");
 
   // 4. Bands and their components: the Reeb graph nodes.
