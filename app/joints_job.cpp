@@ -30,6 +30,8 @@ const OptionSchema<JointsJobOptions>& joints_options() {
               "target facing axis as source_up; -1 = +z for glTF, else detect");
     s.number("leaf_tolerance", [](O& o) -> double& { return o.fit.leaf_tolerance; }, 0, 10,
              "limb ends match when at most this × height apart");
+    s.boolean("match_by_attachment", [](O& o) -> bool& { return o.fit.match_by_attachment; },
+              "source limbs posed unlike the target's (hanging arms against a T-pose) pair with its unmatched limbs by where they join the body");
     s.integer("surface_refine", [](O& o) -> int& { return o.fit.surface_refine_iterations; }, 0, 10,
               "rounds of moving each joint by the local affine map of the source surface around it onto the target (0 = off)");
     s.number("surface_refine_sigma", [](O& o) -> double& { return o.fit.surface_refine_sigma; }, 0.1, 10,

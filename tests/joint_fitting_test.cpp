@@ -266,13 +266,15 @@ TEST(JointFitting, BarbarianSkeletonInKnight) {
 // reached through the hip — step 2b of curve_skeleton cuts such part contacts, and side branches are
 // measured along the geodesic too). RobotExpressive → CesiumMan, refused before, fits: 7.6 %;
 // CesiumMan → RobotExpressive 7.4 → 6.0 %. The bounds hold what was reached, so a regression shows
-// (same figures natively and in wasm).
+// (same figures natively and in wasm). Thirty-third session: the touching-legs split (step 4b) also
+// runs when the source has a third low limb end (the robot's left hand hangs at 0.07 of its
+// height): RobotExpressive → CesiumMan 7.6 → 5.4 %.
 TEST(JointFitting, RobotSkeletonInCesiumMan) {
   const JfRun r = jf_fit_characters("anim/RobotExpressive/RobotExpressive.glb", "anim/CesiumMan/CesiumMan.glb", kRobotToCesium);
   jf_report(this, "RobotExpressive joints in CesiumMan (10 key joints)", r);
   EXPECT_EQ(r.outside, 0);
   EXPECT_EQ(r.error.count, 10);
-  EXPECT_LE(r.error.mean, 0.08);  // issue 14 asks 0.03
+  EXPECT_LE(r.error.mean, 0.058);  // issue 14 asks 0.03
 }
 
 // The refusal of a source limb the target lacks asks for markers; markers on that limb's joints, or
@@ -280,13 +282,16 @@ TEST(JointFitting, RobotSkeletonInCesiumMan) {
 // RobotExpressive → CesiumMan fits (above); a stricter limb-end tolerance (0.4 of the height instead
 // of 0.6) leaves the robot's hanging right arm without a partner in CesiumMan's spread arm. The
 // issue's kind of markers — knees, elbows, neck — taken from CesiumMan's own joints lift the
-// refusal (3.4 % of the height over the 10 key joints); a marker far from the lost limb does not.
+// refusal (2.5 % of the height over the 10 key joints since step 4b's split runs for it; 3.4 %
+// before); a marker far from the lost limb does not. Step 4's second pass would pair the arms by
+// where they join the body, so it is off here.
 TEST(JointFitting, MarkersOnALostLimbLiftTheRefusal) {
   const JfCharacter s = jf_character("anim/RobotExpressive/RobotExpressive.glb"), t = jf_character("anim/CesiumMan/CesiumMan.glb");
   mm::JointFitOptions o;
   o.target_up = 1;
   o.target_front = 2;
   o.leaf_tolerance = 0.4;
+  o.match_by_attachment = false;  // it would pair the arms (RobotSkeletonInWomanPairsHangingArms)
   mm::JointFitResult r = mm::fit_joints(s.c.V_rest, s.c.F, s.joints, t.c.V_rest, t.c.F, {}, o);
   ASSERT_EQ(r.status.code, mm::StatusCode::InvalidArgument);
   EXPECT_NE(r.status.message.find("pin those joints with markers"), std::string::npos) << r.status.message;
@@ -304,8 +309,82 @@ TEST(JointFitting, MarkersOnALostLimbLiftTheRefusal) {
   const JfError e = jf_joint_error(r.joints, t.joints, jf_extent(t.c.V_rest, 1), kRobotToCesium);
   jf_print("RobotExpressive joints in CesiumMan, 5 markers (10 key joints)", e, r);
   EXPECT_EQ(e.count, 10);
-  EXPECT_LE(e.mean, 0.045);
+  EXPECT_LE(e.mean, 0.03);
   EXPECT_EQ(jf_outside(r.joints, t.c.V_rest, t.c.F), 0);
+}
+
+// RobotExpressive's arms hang and the static woman's are spread (T-pose): no position pairs them
+// (the robot's hands hang at 0.07–0.13 of its height, hers are at 0.8), and until the
+// thirty-third session the fit was refused, asking for markers (and with 5 markers put the
+// robot's hands at her feet: 7.2 % of the height). Step 4's second pass pairs limb ends left
+// unmatched by where they join the matched body: 6.2 % over the 10 key joints (her hand-placed
+// joints carry CesiumMan's names), the arms 3.6–8.2 %, the hips 13 % (the robot's legs are a
+// quarter of its height). Without the second pass the fit is refused as before.
+TEST(JointFitting, RobotSkeletonInWomanPairsHangingArms) {
+  const JfCharacter robot = jf_character("anim/RobotExpressive/RobotExpressive.glb");
+  const mm::io::LoadResult woman = mm::io::load_asset(mm::test::data_path("anim/human_woman.ply"));
+  ASSERT_TRUE(woman.status.ok());
+  const mm::io::JointSetResult truth = mm::io::parse_joints_json(jf_read("joints/human_woman_joints.json"));
+  ASSERT_TRUE(truth.status.ok());
+  mm::JointFitResult r = mm::fit_joints(robot.c.V_rest, robot.c.F, robot.joints, woman.asset.V_raw, woman.asset.F_raw);
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
+  EXPECT_TRUE(std::any_of(r.warnings.begin(), r.warnings.end(), [](const std::string& w) {
+    return w.find("paired by where they join the body") != std::string::npos && w.find("Ring2.R") != std::string::npos;
+  }));
+  EXPECT_EQ(r.limb_ends.size(), 5u);
+  const JfError e = jf_joint_error(r.joints, truth.joints, jf_extent(woman.asset.V_raw, 1), kRobotToCesium);
+  jf_print("RobotExpressive joints in human_woman (10 key joints)", e, r);
+  EXPECT_EQ(e.count, 10);
+  EXPECT_LE(e.mean, 0.065);
+  EXPECT_EQ(jf_outside(r.joints, woman.asset.V_raw, woman.asset.F_raw), 0);
+  // Each hand lands in the arm on its own side (+x is the woman's left).
+  for (const char* hand : {"LowerArm.L", "LowerArm.R"}) {
+    const Eigen::Vector3d p = r.joints.P.row(r.joints.find(hand)).transpose();
+    EXPECT_GT(p.y(), 0.7 * jf_extent(woman.asset.V_raw, 1)) << hand << " is not in a raised arm";
+  }
+  EXPECT_GT(r.joints.P(r.joints.find("LowerArm.L"), 0) * r.joints.P(r.joints.find("UpperArm.L"), 0), 0);
+  mm::JointFitOptions off;
+  off.match_by_attachment = false;
+  r = mm::fit_joints(robot.c.V_rest, robot.c.F, robot.joints, woman.asset.V_raw, woman.asset.F_raw, {}, off);
+  EXPECT_EQ(r.status.code, mm::StatusCode::InvalidArgument);
+  EXPECT_NE(r.status.message.find("pin those joints with markers"), std::string::npos) << r.status.message;
+}
+
+// A quadruped without a tail (TOSCA horse0: 4 legs and a head, z up) under the Fox's skeleton
+// (4 legs, head, tail). Until the thirty-third session the facing test turned the horse back to
+// front (its legs still paired, the Fox's raised tail against the horse's head) and refused the
+// Fox's head. An unmatched limb end on the target's side now costs the tolerance too: the facing is
+// right and the refusal names only the tail, which the horse lacks. A marker on the tail's root at
+// the horse's rump lifts it; one on the head (more than marker_reach bones from the tail) does not.
+TEST(JointFitting, QuadrupedWithoutATailIsFacedRightAndAsksForTheTail) {
+  const JfCharacter fox = jf_character("anim/Fox/glTF-Binary/Fox.glb");
+  const mm::io::LoadResult horse = mm::io::load_asset(mm::test::data_path("pose/horse0.ply"));
+  ASSERT_TRUE(horse.status.ok());
+  const Eigen::MatrixXd& V = horse.asset.V_raw;
+  mm::JointFitResult r = mm::fit_joints(fox.c.V_rest, fox.c.F, fox.joints, V, horse.asset.F_raw);
+  ASSERT_EQ(r.status.code, mm::StatusCode::InvalidArgument);
+  std::cout << "[ Fox on horse0 ] " << r.status.message << "\n";
+  EXPECT_NE(r.status.message.find("b_Tail03_014"), std::string::npos) << r.status.message;
+  EXPECT_EQ(r.status.message.find("b_Head_05"), std::string::npos) << r.status.message;
+  EXPECT_NE(r.status.message.find("pin those joints with markers"), std::string::npos) << r.status.message;
+  // The horse's length runs along y, its head at −y (TOSCA), its back at z ≈ 0.65 of its height.
+  const double y0 = V.col(1).minCoeff(), y1 = V.col(1).maxCoeff(), z1 = V.col(2).maxCoeff();
+  auto inside_at = [&](double y, double z) {  // a point on the mid-plane inside the body
+    return Eigen::Vector3d(0.5 * (V.col(0).minCoeff() + V.col(0).maxCoeff()), y, z);
+  };
+  const Eigen::Vector3d rump = inside_at(y1 - 0.06 * (y1 - y0), 0.62 * z1), head = inside_at(y0 + 0.08 * (y1 - y0), 0.8 * z1);
+  r = mm::fit_joints(fox.c.V_rest, fox.c.F, fox.joints, V, horse.asset.F_raw, {{"b_Head_05", head}});
+  EXPECT_EQ(r.status.code, mm::StatusCode::InvalidArgument) << "a marker on the head does not place the tail";
+  r = mm::fit_joints(fox.c.V_rest, fox.c.F, fox.joints, V, horse.asset.F_raw, {{"b_Tail01_012", rump}});
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
+  EXPECT_EQ(jf_outside(r.joints, V, horse.asset.F_raw), 0);
+  EXPECT_LT((r.joints.P.row(r.joints.find("b_Tail01_012")).transpose() - rump).norm(), 1e-12);
+  // Facing: the Fox's head joint in the front fifth of the horse, its hips in the back half.
+  const double head_y = r.joints.P(r.joints.find("b_Head_05"), 1), hip_y = r.joints.P(r.joints.find("b_Hip_01"), 1);
+  std::cout << "[ Fox on horse0, tail pinned ] head at " << (head_y - y0) / (y1 - y0) << ", hips at " << (hip_y - y0) / (y1 - y0)
+            << " of the length from the front\n";
+  EXPECT_LT(head_y, y0 + 0.2 * (y1 - y0));
+  EXPECT_GT(hip_y, y0 + 0.5 * (y1 - y0));
 }
 
 TEST(JointFitting, CesiumManSkeletonInRobot) {

@@ -232,6 +232,73 @@ JfLeafMatch jf_match_leaves(const std::vector<Eigen::Vector3d>& S, const std::ve
   return m;
 }
 
+// Where a limb joins the body: the node of the tree spanned by the matched limb ends (paths
+// between them) closest to `leaf`, i.e. the deepest projection median(leaf, a, b) over matched
+// ends a, b; with one matched end, the branch point of the path to it. Returns the node and the
+// path's arc length from the leaf to it.
+std::pair<int, double> jf_attachment(const JfTree& t, int leaf, const std::vector<int>& matched) {
+  int best = -1;
+  for (size_t i = 0; i < matched.size(); ++i)
+    for (size_t j = i; j < matched.size(); ++j) {
+      const int m = j == i ? t.lca(leaf, matched[i]) : t.median(leaf, matched[i], matched[j]);
+      // every candidate is an ancestor of leaf or on its path down to a matched end; the closest
+      // to the leaf along the tree is the one with the shortest path
+      if (best < 0 || t.path(leaf, m).size() < t.path(leaf, best).size()) best = m;
+    }
+  if (best < 0) return {leaf, 0.0};
+  return {best, jf_path(t, leaf, best).length()};
+}
+
+// Step 4, second pass: source limb ends that carry joints and found no partner by position (a
+// robot's hanging arms against a T-pose) paired with the target's unmatched limb ends by where
+// they join the matched body and where their middles lie (normalised frames, target turned by R),
+// when they join within `tol` × height of each other and their lengths differ by less than 2×.
+// Appends to m->pairs; returns the source ends paired.
+std::vector<int> jf_match_by_attachment(const JfTree& st, const JfTree& tt, const std::vector<int>& s_free,
+                                        const std::vector<int>& t_free, JfLeafMatch* m,
+                                        const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& fs,
+                                        const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& ft, double tol) {
+  std::vector<int> sm, tm, paired;
+  for (const auto& pr : m->pairs) sm.push_back(pr.first), tm.push_back(pr.second);
+  if (s_free.empty() || t_free.empty() || m->pairs.empty()) return paired;
+  struct Limb {
+    Eigen::Vector3d join, middle;
+    double length;
+  };
+  auto limb = [](const JfTree& t, int leaf, const std::vector<int>& matched,
+                 const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& f) {
+    const auto [node, arc] = jf_attachment(t, leaf, matched);
+    Eigen::Vector3d mid;
+    double radius;
+    const JfPath p = jf_path(t, leaf, node);
+    jf_point_at(t, p, 0.5 * arc, &mid, &radius);
+    const Eigen::Vector3d join = f(t.pos(node));
+    double length = 0;  // normalised: the path's length in the frame's units
+    for (size_t i = 1; i < p.nodes.size(); ++i) length += (f(t.pos(p.nodes[i])) - f(t.pos(p.nodes[i - 1]))).norm();
+    return Limb{join, f(mid), length};
+  };
+  const int ns = int(s_free.size()), nt = int(t_free.size());
+  std::vector<Limb> ls, lt;
+  for (int l : s_free) ls.push_back(limb(st, l, sm, fs));
+  for (int l : t_free) lt.push_back(limb(tt, l, tm, ft));
+  Eigen::MatrixXd C = Eigen::MatrixXd::Constant(ns, nt + ns, 1e6);
+  for (int i = 0; i < ns; ++i) {
+    for (int j = 0; j < nt; ++j) {
+      const double dj = (ls[i].join - lt[j].join).norm();
+      const double ratio = std::max(ls[i].length, lt[j].length) / std::max(1e-12, std::min(ls[i].length, lt[j].length));
+      if (dj <= tol && ratio < 2) C(i, j) = 0.5 * (dj + (ls[i].middle - lt[j].middle).norm());
+    }
+    C(i, nt + i) = 2 * tol;
+  }
+  const std::vector<int> col = jf_assignment(C);
+  for (int i = 0; i < ns; ++i)
+    if (col[i] >= 0 && col[i] < nt && C(i, col[i]) < 1e6) {
+      m->pairs.push_back({s_free[i], t_free[col[i]]});
+      paired.push_back(s_free[i]);
+    }
+  return paired;
+}
+
 // The source's joint tree as a skeleton (SourceSkeleton::Bones): nodes = the joints of `used`
 // in the largest connected part of the hierarchy (parent = nearest used ancestor), plus one tip
 // node per leaf joint, where its bone, prolonged, leaves the source's solid — the limb's end, as
@@ -629,7 +696,11 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
       Tn.push_back(f(R * back_point(tt, t_leaves[i], opt.back_length * f.H)));
     }
     JfLeafMatch m = jf_match_leaves(Sn, s_leaves, Tn, t_leaves, opt.leaf_tolerance);
-    const double cost = jf_chamfer(Ps_n, Pt_n) + m.cost / std::max<size_t>(1, s_leaves.size());
+    // An unmatched limb end on either side costs the tolerance: a turn that leaves the head of
+    // both unmatched (a quadruped turned back to front: its legs still pair) loses to one that
+    // pairs them.
+    const double unmatched_t = double(t_leaves.size() - std::min(t_leaves.size(), m.pairs.size()));
+    const double cost = jf_chamfer(Ps_n, Pt_n) + (m.cost + opt.leaf_tolerance * unmatched_t) / double(s_leaves.size() + t_leaves.size());
     if (cost < best_cost) best_cost = cost, match = m, r.rotation = R, ft = f;
   }
   const Eigen::Matrix3d R = r.rotation;
@@ -696,6 +767,28 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     closest_on_edges(source_joints.P.row(j).transpose(), all_edges, &e, &t);
     if (e >= 0 && only_leaf[e] >= 0) joints_on_leaf[only_leaf[e]].push_back(source_joints.names[j]);
   }
+  // 4, second pass: limbs that carry joints and found no partner by position, paired by where
+  // they join the body.
+  if (opt.match_by_attachment) {
+    std::vector<uint8_t> s_taken(ns, 0), t_taken(TS.size(), 0);
+    for (const auto& pr : match.pairs) s_taken[pr.first] = 1, t_taken[pr.second] = 1;
+    std::vector<int> s_free, t_free;
+    for (const auto& [leaf, names] : joints_on_leaf)
+      if (!s_taken[leaf] && names.size() >= 2) s_free.push_back(leaf);
+    for (int l : t_leaves)
+      if (!t_taken[l]) t_free.push_back(l);
+    const std::vector<int> paired = jf_match_by_attachment(
+        st, tt, s_free, t_free, &match, [&](const Eigen::Vector3d& p) { return fs(p); },
+        [&](const Eigen::Vector3d& p) { return ft(R * p); }, opt.leaf_tolerance);
+    if (!paired.empty()) {
+      r.limb_ends = match.pairs;
+      std::vector<std::string> ends;
+      for (int l : paired) ends.push_back(joints_on_leaf[l].back());
+      r.warnings.push_back("the source's limbs ending at " + jf_join(ends) +
+                           " are posed unlike the target's (e.g. hanging arms against a T-pose): they were paired by "
+                           "where they join the body; check those joints");
+    }
+  }
   std::map<int, int> matched_s;  // source leaf node → index in match.pairs
   for (size_t k = 0; k < match.pairs.size(); ++k) matched_s[match.pairs[k].first] = int(k);
   if (opt.check_topology) {
@@ -755,8 +848,10 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     return fail(StatusCode::InvalidArgument, "fewer than 2 limb ends of the target match the source's: place the joints with markers");
 
   // 4b. Touching legs: a biped whose skeleton forks below its crotch. Both curve skeletons are
-  // cut alike (a self-fit stays exact); the source's own bones have a real hip joint.
-  if (r.source_ground == 2 && r.target_ground == 2 && opt.touching_legs_groove > 0) {
+  // cut alike (a self-fit stays exact); the source's own bones have a real hip joint. The feet are
+  // the pairs low on both sides, so a source hand hanging into the ground band (RobotExpressive's,
+  // at 0.07 of its height: 3 "on the ground") does not stop the split.
+  if (r.source_ground <= 3 && r.target_ground == 2 && opt.touching_legs_groove > 0) {
     std::vector<std::pair<int, int>> feet;
     int top = -1;
     double top_height = -std::numeric_limits<double>::infinity();

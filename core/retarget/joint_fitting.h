@@ -7,9 +7,14 @@
 //  2. up direction: the source's is given (glTF +Y); the target's is the signed axis with the
 //     most limb ends (skeleton leaves) near its low end — feet stand on the ground — unless given;
 //  3. facing (unless given, e.g. +z for glTF by its spec): the 4 axis-aligned turns about up are scored by the chamfer distance between the two
-//     solids (normalised: feet at 0, height 1, centred) plus the distance of matched limb ends;
+//     solids (normalised: feet at 0, height 1, centred) plus the distance of matched limb ends
+//     (an unmatched end on either side costs leaf_tolerance: a quadruped turned back to front
+//     still pairs its legs, but leaves both heads unmatched);
 //  4. limb ends are matched greedily by normalised position of the end and of a point back_length
 //     up its path (≤ leaf_tolerance × height apart), so A- and T-poses pair hands with hands;
+//     a second pass pairs source limbs that carry joints and are still unmatched with the
+//     target's unmatched limbs by where they join the matched body and where their middles lie
+//     (match_by_attachment: hanging arms against a T-pose, with a warning);
 //     a source limb end that carries joints with no match is a topology mismatch, and so is a
 //     different number of limbs on the ground (biped vs quadruped);
 //  5. each source joint is located on the source skeleton (closest point q on the paths between
@@ -69,6 +74,8 @@ struct JointFitOptions {
   int target_front = -1;          // target facing axis; −1 = detect (step 3)
   double leaf_tolerance = 0.6;    // limb ends match when ≤ this × height apart (normalised shapes; mean of
                                   // the ends' and the back points' distances)
+  bool match_by_attachment = true; // step 4's second pass: source limbs left unmatched (carrying joints) pair
+                                   // with the target's by where they join the body (poses unlike: hanging vs spread arms)
   double back_length = 0.25;      // back point of a limb end: this × height up its path (pose-robust matching),
   double back_limb_fraction = 0.5; // but at most this × the limb's length to its first branch point
   double ground_band = 0.12;      // limb ends below this × height count as standing on the ground

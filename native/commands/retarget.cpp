@@ -220,10 +220,8 @@ int run_joints(const std::vector<std::string>& argv) {
   const app::JointsJobResult r = app::run_joints_job(src.asset, tgt.asset, markers_json, opt, cli::terminal_progress());
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   for (const auto& w : r.warnings) std::cerr << "meshmorph joints: warning: " << w << "\n";
-  if (!r.status.ok()) return cli::report("joints", r.status);
-  const std::vector<uint8_t> bytes(r.json.begin(), r.json.end());
-  if (!(s = io::write_file_atomic(out_path, bytes)).ok()) return cli::report("joints", s);
-  if (!debug_path.empty()) {
+  // The debug view is written for a refused fit too (the target's skeleton shows why).
+  auto write_debug = [&]() -> Status {
     auto skeleton_set = [](const CurveSkeleton& sk, const Eigen::Matrix3d& to_target, const std::string& name,
                            std::array<float, 4> color) {
       io::DebugGeometry g;
@@ -251,12 +249,20 @@ int run_joints(const std::vector<std::string>& argv) {
     for (int j = 0; j < r.fit.joints.size(); ++j)
       if (r.fit.joints.parent[j] >= 0) bones.lines.push_back({j, r.fit.joints.parent[j]});
     bones.color = {1, 0.6f, 0.1f, 1};
-    sets.push_back(joints);
+    if (joints.P.rows() > 0) sets.push_back(joints);
     if (!bones.lines.empty()) sets.push_back(bones);
     std::vector<uint8_t> glb;
-    if (!(s = io::debug_geometry_glb(sets, &glb)).ok()) return cli::report("joints", s);
-    if (!(s = io::write_file_atomic(debug_path, glb)).ok()) return cli::report("joints", s);
+    if (Status st = io::debug_geometry_glb(sets, &glb); !st.ok()) return st;
+    return io::write_file_atomic(debug_path, glb);
+  };
+  if (!r.status.ok()) {
+    if (!debug_path.empty() && r.fit.target_skeleton.size() > 0 && write_debug().ok())
+      std::cerr << "meshmorph joints: wrote " << debug_path << " (the target's skeleton; no joints)\n";
+    return cli::report("joints", r.status);
   }
+  const std::vector<uint8_t> bytes(r.json.begin(), r.json.end());
+  if (!(s = io::write_file_atomic(out_path, bytes)).ok()) return cli::report("joints", s);
+  if (!debug_path.empty() && !(s = write_debug()).ok()) return cli::report("joints", s);
   const auto& fit = r.fit;
   std::cout << "joints: " << fit.joints.size() << " joints placed (" << fit.skipped.size()
             << " source joints outside the source surface skipped) in " << static_cast<int>(ms) << " ms; skeletons "
