@@ -79,6 +79,7 @@ struct JointFitOptions {
   double back_length = 0.25;      // back point of a limb end: this × height up its path (pose-robust matching),
   double back_limb_fraction = 0.5; // but at most this × the limb's length to its first branch point
   double ground_band = 0.12;      // limb ends below this × height count as standing on the ground
+  double ground_step = 0.04;      // ... and within this × height of the lowest limb end (a hand hanging low is no foot)
   double min_up_extent = 0.3;     // a detected up axis spans at least this × the longest extent
   double inside_tolerance = 0.01; // a joint within this × bbox diagonal outside the surface counts as inside
   double touching_legs_groove = 0.95;// biped target: trunk nodes above the leg fork whose front-to-back thickness
