@@ -1255,15 +1255,23 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
   if (!markers.empty() && auto_tree) curve_r = r;
   r.source_skeleton = jf_bone_skeleton(r.source_skeleton, source_joints, used, bvh_s);
   if (!r.source_skeleton.status.ok()) return fail(r.source_skeleton.status.code, r.source_skeleton.status.message);
-  JointFitResult bones = jf_fit_on_skeletons(r, in, false, nullptr, true);
+  // Auto: the bones without lifting lost limbs, then the markers lift the curve skeleton's, then
+  // the bones' (the Fox in a tailless horse with a pin on the tail: the bones had lost a foot too,
+  // lifted by that pin 5 bones away, and put a hind leg's joints across the body).
+  JointFitResult bones = jf_fit_on_skeletons(r, in, false, nullptr, !curve_r);
   bones.source_tree = SourceSkeleton::Bones;
   if (opt.source_skeleton == SourceSkeleton::Bones) return bones;
   if (!bones.status.ok()) {
-    if (curve_r) {  // neither tree fits: the curve skeleton's lost limbs from the markers
+    if (curve_r) {  // neither tree fits: the curve skeleton's lost limbs from the markers, then the bones'
       JointFitResult lifted = jf_fit_on_skeletons(*curve_r, in, true, nullptr, true);
       lifted.source_tree = SourceSkeleton::Voxel;
       if (lifted.status.ok()) return lifted;
+      JointFitResult bones_lifted = jf_fit_on_skeletons(r, in, false, nullptr, true);
+      bones_lifted.source_tree = SourceSkeleton::Bones;
+      if (bones_lifted.status.ok()) bones = std::move(bones_lifted);
     }
+  }
+  if (!bones.status.ok()) {
     voxel.status = Status::error(voxel.status.code, voxel.status.message + " (the source's own bones do not fit either: " +
                                                         bones.status.message + ")");
     return voxel;
