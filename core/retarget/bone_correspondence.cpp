@@ -58,7 +58,11 @@ BoneCorrespondence bone_correspondence(const Eigen::MatrixXd& Y, const std::vect
       const Eigen::Vector3d p = Jt.row(bones[b].second).transpose(), c = Jt.row(bones[b].first).transpose();
       const Eigen::Vector3d d = c - p;
       ub[b] = std::clamp((y - p).dot(d) / std::max(1e-300, d.squaredNorm()), 0.0, 1.0);
-      qb[b] = p + ub[b] * d;
+      // A clamped point is the joint itself, bit for bit: the bones meeting there then tie
+      // exactly and the lower index wins. (p + 1·d is not c in floating point; the last bits
+      // decided between the two bones for every y whose nearest bone point is their shared
+      // joint, and moving the joints by 1e-9 moved a retargeted Fox → wolf0 frame by 0.37 units.)
+      qb[b] = ub[b] <= 0 ? p : ub[b] >= 1 ? c : Eigen::Vector3d(p + ub[b] * d);
       order[b] = {(y - qb[b]).squaredNorm(), b};
     }
     std::sort(order.begin(), order.end());
@@ -76,7 +80,7 @@ BoneCorrespondence bone_correspondence(const Eigen::MatrixXd& Y, const std::vect
     const Eigen::Vector3d o = y - qb[pick];
     const double len = o.norm();
     const Eigen::Vector3d ps = Js.row(bones[pick].second).transpose(), cs = Js.row(bones[pick].first).transpose();
-    const Eigen::Vector3d qs = ps + ub[pick] * (cs - ps);
+    const Eigen::Vector3d qs = ub[pick] <= 0 ? ps : ub[pick] >= 1 ? cs : Eigen::Vector3d(ps + ub[pick] * (cs - ps));
     r.bone[i] = pick;
     r.u[i] = ub[pick];
     if (len < 1e-12) {
