@@ -282,10 +282,11 @@ TEST(JointFitting, RobotSkeletonInCesiumMan) {
 // RobotExpressive → CesiumMan fits (above); a stricter limb-end tolerance (0.4 of the height instead
 // of 0.6) leaves the robot's hanging right arm without a partner in CesiumMan's spread arm. The
 // issue's kind of markers — knees, elbows, neck — taken from CesiumMan's own joints lift the
-// refusal (3.6 % of the height over the 10 key joints; 3.4 % before the thirty-third session,
-// when the robot's hanging hands still counted as feet and its own bones (Auto's second try) were
-// refused — they fit now); a marker far from the lost limb does not. Step 4's second pass would
-// pair the arms by where they join the body, so it is off here.
+// refusal (2.5 % of the height over the 10 key joints; 3.4 % before the thirty-third session,
+// whose touching-legs split now runs for the robot); a marker far from the lost limb does not.
+// (The robot's own bones, Auto's second try, lose an arm too; markers lift the curve skeleton's
+// refusal before theirs.) Step 4's second pass would pair the arms by where they join the body,
+// so it is off here.
 TEST(JointFitting, MarkersOnALostLimbLiftTheRefusal) {
   const JfCharacter s = jf_character("anim/RobotExpressive/RobotExpressive.glb"), t = jf_character("anim/CesiumMan/CesiumMan.glb");
   mm::JointFitOptions o;
@@ -310,7 +311,7 @@ TEST(JointFitting, MarkersOnALostLimbLiftTheRefusal) {
   const JfError e = jf_joint_error(r.joints, t.joints, jf_extent(t.c.V_rest, 1), kRobotToCesium);
   jf_print("RobotExpressive joints in CesiumMan, 5 markers (10 key joints)", e, r);
   EXPECT_EQ(e.count, 10);
-  EXPECT_LE(e.mean, 0.04);
+  EXPECT_LE(e.mean, 0.03);
   EXPECT_EQ(jf_outside(r.joints, t.c.V_rest, t.c.F), 0);
 }
 
