@@ -187,8 +187,9 @@ J.json is {"joint name": [x, y, z]} in TARGET's coordinates, ready for
 
   --markers M.json         {"joint name": [x, y, z]}: pin these source joints (chin, wrists,
                            knees, ...) where the automatic fit is wrong
-  --debug-skeleton OUT.glb both skeletons (lines), the fitted joints and bones, and the target
-                           surface (translucent), for viewing
+  --debug-skeleton OUT.glb the target's curve skeleton (lines), the fitted joints and bones,
+                           and the target surface (translucent), for viewing; written for a
+                           refused fit too (the skeleton alone)
 options (app/joints_job.h):
 )";
 
