@@ -233,17 +233,16 @@ JfLeafMatch jf_match_leaves(const std::vector<Eigen::Vector3d>& S, const std::ve
 }
 
 // Where a limb joins the body: the node of the tree spanned by the matched limb ends (paths
-// between them) closest to `leaf`, i.e. the deepest projection median(leaf, a, b) over matched
-// ends a, b; with one matched end, the branch point of the path to it. Returns the node and the
-// path's arc length from the leaf to it.
+// between them) closest to `leaf` along the tree — the projections median(leaf, a, b) over
+// matched ends a, b (lca(leaf, a) for a single end), the one fewest edges from the leaf. Returns
+// the node and the path's arc length from the leaf to it.
 std::pair<int, double> jf_attachment(const JfTree& t, int leaf, const std::vector<int>& matched) {
+  auto edges_from_leaf = [&](int m) { return t.depth[leaf] + t.depth[m] - 2 * t.depth[t.lca(leaf, m)]; };
   int best = -1;
   for (size_t i = 0; i < matched.size(); ++i)
     for (size_t j = i; j < matched.size(); ++j) {
       const int m = j == i ? t.lca(leaf, matched[i]) : t.median(leaf, matched[i], matched[j]);
-      // every candidate is an ancestor of leaf or on its path down to a matched end; the closest
-      // to the leaf along the tree is the one with the shortest path
-      if (best < 0 || t.path(leaf, m).size() < t.path(leaf, best).size()) best = m;
+      if (best < 0 || edges_from_leaf(m) < edges_from_leaf(best)) best = m;
     }
   if (best < 0) return {leaf, 0.0};
   return {best, jf_path(t, leaf, best).length()};
