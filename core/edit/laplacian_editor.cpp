@@ -104,8 +104,10 @@ Status LaplacianEditor::Impl::build(const Eigen::MatrixXd& Vin, const Eigen::Mat
   if (s.implicit && max_threads() > 1)
     poisson = Task([this, &s, &poisson_status] { poisson_status = build_finalize_system(s, Progress{}); });
 #endif
-  if (!poisson.valid())
+  if (!poisson.valid()) {
     if (Status st = build_finalize_system(s, progress); !st.ok()) return st;
+    s.clock = std::chrono::steady_clock::now();  // the Poisson stage has its own timing
+  }
   if (!progress.update("edit: assembling", 0.1)) return cancelled_status("edit: assembling");
   if (s.implicit) {
     // An early return waits for the Poisson task (its destructor).

@@ -128,6 +128,22 @@ Status LaplacianEditor::Impl::build_similarity_system(EditBuild& s, const Progre
   std::vector<int> mark(nL, -1), touched;
   std::vector<int> y_ptr(nP + 1, 0), y_idx;
   std::vector<double> y_val;
+  {
+    // Reserved at an upper bound (Σ of the stencil sizes over each list's centers) instead of
+    // grown: growing copied these lists (~2M entries at 50k vertices) several times over.
+    size_t bound = 0;
+    auto stencil_size = [&](int q) {
+      const int c = center_index[pair_centers[q]];
+      return static_cast<size_t>(grads.offsets[c + 1] - grads.offsets[c]);
+    };
+    for (int p = 0; p < nP; ++p) {
+      if (!is_active[center_index[pair_centers[p]]]) continue;
+      bound += stencil_size(p);
+      for (int k = partner_ptr[p]; k < partner_ptr[p + 1]; ++k) bound += stencil_size(partners[k]);
+    }
+    y_idx.reserve(bound);
+    y_val.reserve(3 * bound);
+  }
   for (int p = 0; p < nP; ++p) {
     y_ptr[p + 1] = y_ptr[p];
     if (!is_active[center_index[pair_centers[p]]]) continue;

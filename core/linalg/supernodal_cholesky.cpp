@@ -4,7 +4,9 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
+#include <type_traits>
 
 #include <Eigen/Cholesky>
 #include <Eigen/OrderingMethods>
@@ -17,35 +19,30 @@ namespace supernodal_detail {
 
 using SnSparse = Eigen::SparseMatrix<double>;
 
-// Lower triangle of P A Pᵀ, where row/column i of A becomes p[i]. Counting sort by column, then
-// a small sort per column: O(nnz) instead of sorting triplets.
-SnSparse sn_permuted_lower(const SnSparse& A, const std::vector<int>& p) {
+// Lower (or, with `upper`, upper) triangle of P A Pᵀ, where row/column i of A becomes p[i]: one
+// counting sort by column, O(nnz). Row indices within a column are left in the order A's entries
+// come in (not sorted): everything below reads columns as sets (the elimination tree, the counts,
+// the row structure, and the assembly, where each position receives exactly one value).
+SnSparse sn_permuted_triangle(const SnSparse& A, const std::vector<int>& p, bool upper) {
   const int n = static_cast<int>(A.cols());
   std::vector<int> count(n + 1, 0);
   for (int j = 0; j < n; ++j)
     for (SnSparse::InnerIterator it(A, j); it; ++it)
-      if (it.row() >= j) ++count[std::min(p[it.row()], p[j]) + 1];
+      if (it.row() >= j) ++count[(upper ? std::max(p[it.row()], p[j]) : std::min(p[it.row()], p[j])) + 1];
   for (int j = 0; j < n; ++j) count[j + 1] += count[j];
   SnSparse C(n, n);
   C.resizeNonZeros(count[n]);
-  std::vector<int> fill(count.begin(), count.end() - 1);
-  std::vector<std::pair<int, double>> entries(static_cast<size_t>(count[n]));
+  std::copy(count.begin(), count.end(), C.outerIndexPtr());
+  int* fill = count.data();
   for (int j = 0; j < n; ++j)
     for (SnSparse::InnerIterator it(A, j); it; ++it) {
       if (it.row() < j) continue;  // only the lower triangle is read
       const int a = p[it.row()], b = p[j];
-      entries[fill[std::min(a, b)]++] = {std::max(a, b), it.value()};
+      const int col = upper ? std::max(a, b) : std::min(a, b);
+      const int k = fill[col]++;
+      C.innerIndexPtr()[k] = upper ? std::min(a, b) : std::max(a, b);
+      C.valuePtr()[k] = it.value();
     }
-  for (int j = 0; j < n; ++j) {
-    std::sort(entries.begin() + count[j], entries.begin() + count[j + 1]);
-    C.outerIndexPtr()[j] = count[j];
-  }
-  C.outerIndexPtr()[n] = count[n];
-  // Duplicates cannot occur (A has one entry per position), so the pattern maps one to one.
-  for (int k = 0; k < count[n]; ++k) {
-    C.innerIndexPtr()[k] = entries[k].first;
-    C.valuePtr()[k] = entries[k].second;
-  }
   return C;
 }
 
@@ -137,15 +134,14 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P = Pinv.inverse();
     for (int i = 0; i < n; ++i) perm_[i] = P.indices()[i];
   }
-  SnSparse C = sn_permuted_lower(A, perm_);
   {
-    const std::vector<int> order = sn_postorder(sn_elimination_tree(SnSparse(C.transpose())));
+    const std::vector<int> order = sn_postorder(sn_elimination_tree(sn_permuted_triangle(A, perm_, true)));
     std::vector<int> q(n);
     for (int k = 0; k < n; ++k) q[order[k]] = k;
     for (int i = 0; i < n; ++i) perm_[i] = q[perm_[i]];
-    C = sn_permuted_lower(A, perm_);
   }
-  const SnSparse U = C.transpose();
+  const SnSparse C = sn_permuted_triangle(A, perm_, false);
+  const SnSparse U = sn_permuted_triangle(A, perm_, true);
   const std::vector<int> parent = sn_elimination_tree(U);
   if (!progress.update("factor: analysis", 0.5)) return cancelled_status("factor");
 
@@ -234,7 +230,8 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
   // ---- numeric multifrontal factorization in sn_postorder. Each supernode's update matrix waits
   // in its own slot until the parent assembles it (children in reverse order, as a stack would
   // pop them: the sums, and so the factor, do not depend on which thread did what).
-  std::vector<std::vector<double>> updates(ns);
+  // (Uninitialised storage: only the lower triangle is written and read.)
+  std::vector<std::unique_ptr<double[]>> updates(ns);
   struct Scratch {
     std::vector<int> relpos;
     std::vector<double> front;
@@ -245,7 +242,11 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     const int* R = rows_.data() + rows_ptr_[s];
     for (int k = 0; k < ncols; ++k) w.relpos[f + k] = k;
     for (int k = 0; k < nr; ++k) w.relpos[R[k]] = ncols + k;
-    w.front.assign(static_cast<size_t>(m) * m, 0.0);
+    // Only the lower triangle of the front is ever read (assembly, LLT, the rank update and the
+    // copies below), so only it is cleared.
+    if (w.front.size() < static_cast<size_t>(m) * m) w.front.resize(static_cast<size_t>(m) * m);
+    for (int j = 0; j < m; ++j)
+      std::fill(w.front.begin() + static_cast<long>(j) * m + j, w.front.begin() + static_cast<long>(j + 1) * m, 0.0);
     Eigen::Map<Eigen::MatrixXd> Fm(w.front.data(), m, m);
     for (int j = f; j < l; ++j)
       for (SnSparse::InnerIterator it(C, j); it; ++it) Fm(w.relpos[it.row()], j - f) += it.value();
@@ -254,12 +255,12 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
       const int child = children[s][c];
       const int cn = rows_ptr_[child + 1] - rows_ptr_[child];
       const int* CR = rows_.data() + rows_ptr_[child];
-      const std::vector<double>& Uc = updates[child];
+      const double* Uc = updates[child].get();
       for (int b = 0; b < cn; ++b) {
         const int cb = w.relpos[CR[b]];
         for (int a = b; a < cn; ++a) Fm(w.relpos[CR[a]], cb) += Uc[static_cast<size_t>(b) * cn + a];
       }
-      std::vector<double>().swap(updates[child]);
+      updates[child].reset();
     }
     // Dense partial factorization: F11 = L11 L11ᵀ, L21 = F21 L11⁻ᵀ, update F22 −= L21 L21ᵀ.
     auto F11 = Fm.topLeftCorner(ncols, ncols);
@@ -273,10 +274,12 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
       F11.triangularView<Eigen::Lower>().transpose().solveInPlace<Eigen::OnTheRight>(F21);
       auto F22 = Fm.bottomRightCorner(nr, nr);
       F22.selfadjointView<Eigen::Lower>().rankUpdate(F21, -1.0);
-      updates[s].resize(static_cast<size_t>(nr) * nr);
-      Eigen::Map<Eigen::MatrixXd>(updates[s].data(), nr, nr) = F22;
+      updates[s].reset(new double[static_cast<size_t>(nr) * nr]);
+      Eigen::Map<Eigen::MatrixXd> Us(updates[s].get(), nr, nr);
+      for (int b = 0; b < nr; ++b) Us.col(b).tail(nr - b) = F22.col(b).tail(nr - b);
     }
-    Eigen::Map<Eigen::MatrixXd>(values_.data() + value_ptr_[s], m, ncols) = Fm.leftCols(ncols);
+    Eigen::Map<Eigen::MatrixXd> Ls(values_.data() + value_ptr_[s], m, ncols);
+    for (int k = 0; k < ncols; ++k) Ls.col(k).tail(m - k) = Fm.col(k).tail(m - k);
     for (int k = 0; k < ncols; ++k) {
       const double d = values_[value_ptr_[s] + static_cast<long>(k) * m + k];
       if (!(d > 0) || !std::isfinite(d))
@@ -392,6 +395,7 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
 
 void SupernodalCholesky::solve_in_place(Eigen::MatrixXd& B) const {
   const int k = static_cast<int>(B.cols());
+  if (k == 0 || n_ == 0) return;
   // Row-major work arrays: the gathers and scatters touch whole rows (k values each), which are
   // then contiguous instead of k cache lines apart.
   RowMatrix Y(n_, k);
@@ -410,31 +414,177 @@ void SupernodalCholesky::solve_in_place(Eigen::MatrixXd& B) const {
   for (int i = 0; i < n_; ++i) B.row(i) = Y.row(perm_[i]);
 }
 
-// Right-hand sides up to which the solves' panel products are plain loops (measured on michael3's
-// Eq. 7 factor, one thread: the handle basis and a one-solve drag 25 % faster than Eigen's GEMM).
+// Right-hand sides up to which the solves use the loops below instead of Eigen's triangular
+// solve and GEMM (which pack their operands first). Measured on michael3's Eq. 7 factor (48k
+// unknowns, 14M stored entries), one thread, one solve: 1 / 3 / 4 / 8 right-hand sides 24 / 33 /
+// 34 / 48 ms, against 46 / 55 / 55 / 62 ms with per-column loops of run-time length and Eigen's
+// triangular solves; reading the factor twice at this machine's ~10 GB/s takes ~22 ms.
 constexpr long kSkinny = 8;
+
+namespace supernodal_detail {
+
+// Calls f(std::integral_constant<int, K>) for k = K in 1..kSkinny: the panel loops below get a
+// compile-time row length, so they unroll and vectorise over the right-hand sides.
+template <class F>
+void sn_skinny(int k, F&& f) {
+  switch (k) {
+    case 1: f(std::integral_constant<int, 1>()); break;
+    case 2: f(std::integral_constant<int, 2>()); break;
+    case 3: f(std::integral_constant<int, 3>()); break;
+    case 4: f(std::integral_constant<int, 4>()); break;
+    case 5: f(std::integral_constant<int, 5>()); break;
+    case 6: f(std::integral_constant<int, 6>()); break;
+    case 7: f(std::integral_constant<int, 7>()); break;
+    default: f(std::integral_constant<int, 8>()); break;
+  }
+}
+static_assert(kSkinny == 8, "sn_skinny dispatches 1..8 right-hand sides");
+
+// Columns per pass of the panel loops: enough to load and store each row of t once per several
+// columns, few enough that the K·B sums stay in registers.
+template <int K>
+constexpr int sn_panel_block() { return K <= 4 ? 8 : 4; }
+
+// A row of K right-hand sides as an Eigen fixed-size array: Eigen's own packets over the row
+// (the compilers' auto-vectorisers instead vectorised the loops over rows, with in-order scalar
+// reductions). Element-wise, so each entry rounds as the scalar loop would.
+template <int K>
+using SnRow = Eigen::Array<double, K, 1>;
+template <int K>
+using SnRowMap = Eigen::Map<SnRow<K>>;
+template <int K>
+using SnConstRowMap = Eigen::Map<const SnRow<K>>;
+
+// t = P y: P the nr by ncols panel (column-major, column stride ld), y ncols by K and t nr by K
+// (both row-major). B columns per pass over the rows; every t(a, j) sums its terms in column
+// order.
+template <int K>
+void sn_panel_times(const double* P, long ld, int nr, int ncols, const double* y, double* t) {
+  constexpr int B = sn_panel_block<K>();
+  for (long i = 0; i < static_cast<long>(nr) * K; ++i) t[i] = 0.0;
+  int c = 0;
+  for (; c + B <= ncols; c += B) {
+    const double* p = P + c * ld;
+    SnRow<K> yq[B];
+    for (int q = 0; q < B; ++q) yq[q] = SnConstRowMap<K>(y + static_cast<long>(c + q) * K);
+    for (int a = 0; a < nr; ++a) {
+      SnRowMap<K> ta(t + static_cast<long>(a) * K);
+      SnRow<K> r = ta;
+      for (int q = 0; q < B; ++q) r += p[q * ld + a] * yq[q];
+      ta = r;
+    }
+  }
+  for (; c < ncols; ++c) {
+    const double* pc = P + c * ld;
+    const SnRow<K> yc = SnConstRowMap<K>(y + static_cast<long>(c) * K);
+    for (int a = 0; a < nr; ++a) SnRowMap<K>(t + static_cast<long>(a) * K) += pc[a] * yc;
+  }
+}
+
+// t −= P y (shapes as above), t(a, j) subtracting in column order.
+template <int K>
+void sn_panel_subtract(const double* P, long ld, int nr, int ncols, const double* y, double* t) {
+  constexpr int B = sn_panel_block<K>();
+  int c = 0;
+  for (; c + B <= ncols; c += B) {
+    const double* p = P + c * ld;
+    SnRow<K> yq[B];
+    for (int q = 0; q < B; ++q) yq[q] = SnConstRowMap<K>(y + static_cast<long>(c + q) * K);
+    for (int a = 0; a < nr; ++a) {
+      SnRowMap<K> ta(t + static_cast<long>(a) * K);
+      SnRow<K> r = ta;
+      for (int q = 0; q < B; ++q) r -= p[q * ld + a] * yq[q];
+      ta = r;
+    }
+  }
+  for (; c < ncols; ++c) {
+    const double* pc = P + c * ld;
+    const SnRow<K> yc = SnConstRowMap<K>(y + static_cast<long>(c) * K);
+    for (int a = 0; a < nr; ++a) SnRowMap<K>(t + static_cast<long>(a) * K) -= pc[a] * yc;
+  }
+}
+
+// y −= Pᵀ t (shapes as above): B columns' sums at once over the rows of t, each summed in row
+// order.
+template <int K>
+void sn_panel_transpose_times(const double* P, long ld, int nr, int ncols, const double* t, double* y) {
+  constexpr int B = sn_panel_block<K>();
+  int c = 0;
+  for (; c + B <= ncols; c += B) {
+    const double* p = P + c * ld;
+    SnRow<K> acc[B];
+    for (int q = 0; q < B; ++q) acc[q].setZero();
+    for (int a = 0; a < nr; ++a) {
+      const SnRow<K> ta = SnConstRowMap<K>(t + static_cast<long>(a) * K);
+      for (int q = 0; q < B; ++q) acc[q] += p[q * ld + a] * ta;
+    }
+    for (int q = 0; q < B; ++q) SnRowMap<K>(y + static_cast<long>(c + q) * K) -= acc[q];
+  }
+  for (; c < ncols; ++c) {
+    const double* pc = P + c * ld;
+    SnRow<K> acc = SnRow<K>::Zero();
+    for (int a = 0; a < nr; ++a) acc += pc[a] * SnConstRowMap<K>(t + static_cast<long>(a) * K);
+    SnRowMap<K>(y + static_cast<long>(c) * K) -= acc;
+  }
+}
+
+// Y := D⁻¹ Y and Y := D⁻ᵀ Y for the supernode's diagonal block D (lower, column-major, column
+// stride ld) and Y ncols by K row-major, by blocks of B columns: a small triangle, then the
+// rows below it by the panel loops (Eigen's blocked triangular solve packs its operands first,
+// which dominates for a few right-hand sides).
+template <int K>
+void sn_diagonal_solve(const double* D, long ld, int ncols, double* y) {
+  constexpr int B = sn_panel_block<K>();
+  for (int cb = 0; cb < ncols; cb += B) {
+    const int ce = std::min(cb + B, ncols);
+    for (int c = cb; c < ce; ++c) {
+      const double* dc = D + c * ld;
+      SnRowMap<K> yc(y + static_cast<long>(c) * K);
+      yc /= dc[c];
+      for (int r = c + 1; r < ce; ++r) SnRowMap<K>(y + static_cast<long>(r) * K) -= dc[r] * yc;
+    }
+    if (ce < ncols)
+      sn_panel_subtract<K>(D + cb * ld + ce, ld, ncols - ce, ce - cb, y + static_cast<long>(cb) * K,
+                           y + static_cast<long>(ce) * K);
+  }
+}
+template <int K>
+void sn_diagonal_transpose_solve(const double* D, long ld, int ncols, double* y) {
+  constexpr int B = sn_panel_block<K>();
+  for (int cb = (ncols - 1) / B * B; cb >= 0; cb -= B) {
+    const int ce = std::min(cb + B, ncols);
+    if (ce < ncols)
+      sn_panel_transpose_times<K>(D + cb * ld + ce, ld, ncols - ce, ce - cb, y + static_cast<long>(ce) * K,
+                                  y + static_cast<long>(cb) * K);
+    for (int c = ce - 1; c >= cb; --c) {
+      const double* dc = D + c * ld;
+      SnRowMap<K> yc(y + static_cast<long>(c) * K);
+      for (int r = c + 1; r < ce; ++r) yc -= dc[r] * SnConstRowMap<K>(y + static_cast<long>(r) * K);
+      yc /= dc[c];
+    }
+  }
+}
+
+}  // namespace supernodal_detail
 
 void SupernodalCholesky::forward_supernode(int s, RowMatrix& Y, RowMatrix& tmp, int limit, SolveLog* log) const {
   const int f = start_[s], ncols = start_[s + 1] - f, nr = rows_ptr_[s + 1] - rows_ptr_[s], m = ncols + nr;
   const Eigen::Map<const Eigen::MatrixXd> L(values_.data() + value_ptr_[s], m, ncols);
   auto Ys = Y.middleRows(f, ncols);
-  L.topRows(ncols).triangularView<Eigen::Lower>().solveInPlace(Ys);
-  if (nr == 0) return;
   if (Y.cols() <= kSkinny) {
-    // tmp = L21 Ys for a few right-hand sides (drags, refinement, the handle basis): one pass over
-    // L21's columns; Eigen's GEMM copies (packs) the panel first, which cost as much as the product.
-    const long k = Y.cols();
-    tmp.setZero(nr, k);
-    for (int c = 0; c < ncols; ++c) {
-      const double* col = L.data() + static_cast<long>(c) * m + ncols;
-      const double* y = Ys.row(c).data();
-      for (int a = 0; a < nr; ++a) {
-        double* t = tmp.row(a).data();
-        const double l = col[a];
-        for (long j = 0; j < k; ++j) t[j] += l * y[j];
-      }
-    }
+    // A few right-hand sides (drags, refinement, the handle basis): plain loops over the
+    // supernode's columns; Eigen's triangular solve and GEMM copy (pack) their operands first,
+    // which cost as much as the products. tmp = L21 Ys in one pass over L21.
+    sn_skinny(static_cast<int>(Y.cols()), [&](auto K) {
+      sn_diagonal_solve<decltype(K)::value>(L.data(), m, ncols, Ys.data());
+      if (nr == 0) return;
+      tmp.resize(nr, Y.cols());
+      sn_panel_times<decltype(K)::value>(L.data() + ncols, m, nr, ncols, Ys.data(), tmp.data());
+    });
+    if (nr == 0) return;
   } else {
+    L.topRows(ncols).triangularView<Eigen::Lower>().solveInPlace(Ys);
+    if (nr == 0) return;
     tmp.noalias() = L.bottomRows(nr) * Ys;
   }
   const int* R = rows_.data() + rows_ptr_[s];
@@ -457,25 +607,20 @@ void SupernodalCholesky::backward_supernode(int s, RowMatrix& Y, RowMatrix& tmp)
     const int* R = rows_.data() + rows_ptr_[s];
     for (int a = 0; a < nr; ++a) tmp.row(a) = Y.row(R[a]);
     if (Y.cols() <= kSkinny) {
-      // Ys −= L21ᵀ tmp column by column of L21 (one pass over the panel, as above).
-      const long k = Y.cols();
-      double acc[kSkinny];
-      for (int c = 0; c < ncols; ++c) {
-        const double* col = L.data() + static_cast<long>(c) * m + ncols;
-        for (long j = 0; j < k; ++j) acc[j] = 0.0;
-        for (int a = 0; a < nr; ++a) {
-          const double* t = tmp.row(a).data();
-          const double l = col[a];
-          for (long j = 0; j < k; ++j) acc[j] += l * t[j];
-        }
-        double* y = Ys.row(c).data();
-        for (long j = 0; j < k; ++j) y[j] -= acc[j];
-      }
+      // Ys −= L21ᵀ tmp (one pass over the panel, as above).
+      sn_skinny(static_cast<int>(Y.cols()), [&](auto K) {
+        sn_panel_transpose_times<decltype(K)::value>(L.data() + ncols, m, nr, ncols, tmp.data(), Ys.data());
+      });
     } else {
       Ys.noalias() -= L.bottomRows(nr).transpose() * tmp;
     }
   }
-  L.topRows(ncols).triangularView<Eigen::Lower>().transpose().solveInPlace(Ys);
+  if (Y.cols() <= kSkinny)
+    sn_skinny(static_cast<int>(Y.cols()), [&](auto K) {
+      sn_diagonal_transpose_solve<decltype(K)::value>(L.data(), m, ncols, Ys.data());
+    });
+  else
+    L.topRows(ncols).triangularView<Eigen::Lower>().transpose().solveInPlace(Ys);
 }
 
 // The solves on the factor's split. Forward: each thread runs its subtrees; an update aimed at a
