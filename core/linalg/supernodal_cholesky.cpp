@@ -13,6 +13,10 @@
 
 #include "common/threads.h"
 
+#if defined(__wasm_simd128__)
+#include <wasm_simd128.h>
+#endif
+
 namespace mm {
 
 namespace supernodal_detail {
@@ -100,6 +104,52 @@ bool sn_relax_merge(int ncols, double zero_fraction) {
   if (ncols <= 48) return zero_fraction < 0.1;
   return zero_fraction < 0.05;
 }
+
+#if defined(__wasm_simd128__)
+// C −= A Aᵀ on C's lower triangle, C n by n and A n by k (both column-major, strides ldc and
+// lda): the front's rank update in WebAssembly, where Eigen 3.4 has no packet math and its
+// GEMM runs scalar. A is copied into panels of 4 rows (k × 4, contiguous); each 4 × 4 block of C
+// keeps its sums in eight f64x2 registers over k. Every entry sums its k products in order, then
+// is subtracted once (natively Eigen's GEMM blocks differently: the last bits differ).
+void sn_rank_update_lower_simd(double* C, long ldc, const double* A, long lda, int n, int k, std::vector<double>& pack) {
+  const int nb = (n + 3) / 4;
+  pack.assign(static_cast<size_t>(nb) * k * 4, 0.0);
+  for (int b = 0; b < nb; ++b) {
+    const int r0 = 4 * b, rn = std::min(4, n - r0);
+    double* pb = pack.data() + static_cast<size_t>(b) * k * 4;
+    for (int q = 0; q < k; ++q)
+      for (int r = 0; r < rn; ++r) pb[4 * q + r] = A[q * lda + r0 + r];
+  }
+  for (int jb = 0; jb < nb; ++jb) {
+    const double* pj = pack.data() + static_cast<size_t>(jb) * k * 4;
+    for (int ib = jb; ib < nb; ++ib) {
+      const double* pi = pack.data() + static_cast<size_t>(ib) * k * 4;
+      v128_t c[4][2];
+      for (int q = 0; q < 4; ++q) c[q][0] = c[q][1] = wasm_f64x2_splat(0.0);
+      for (int q = 0; q < k; ++q) {
+        const v128_t a0 = wasm_v128_load(pi + 4 * q), a1 = wasm_v128_load(pi + 4 * q + 2);
+        for (int t = 0; t < 4; ++t) {
+          const v128_t b = wasm_f64x2_splat(pj[4 * q + t]);
+          c[t][0] = wasm_f64x2_add(c[t][0], wasm_f64x2_mul(a0, b));
+          c[t][1] = wasm_f64x2_add(c[t][1], wasm_f64x2_mul(a1, b));
+        }
+      }
+      double out[4][4];
+      for (int t = 0; t < 4; ++t) {
+        wasm_v128_store(&out[t][0], c[t][0]);
+        wasm_v128_store(&out[t][2], c[t][1]);
+      }
+      for (int t = 0; t < 4 && 4 * jb + t < n; ++t) {
+        const int col = 4 * jb + t;
+        for (int r = 0; r < 4 && 4 * ib + r < n; ++r) {
+          const int row = 4 * ib + r;
+          if (row >= col) C[col * ldc + row] -= out[t][r];
+        }
+      }
+    }
+  }
+}
+#endif
 
 }  // namespace supernodal_detail
 
@@ -235,6 +285,8 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
   struct Scratch {
     std::vector<int> relpos;
     std::vector<double> front;
+    std::vector<double> pack;  // wasm rank update's row panels
+    std::vector<int> rel;      // a child's rows in the front
   };
   auto factor_supernode = [&](int s, Scratch& w) -> Status {
     const int f = start_[s], l = start_[s + 1], ncols = l - f;
@@ -256,9 +308,13 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
       const int cn = rows_ptr_[child + 1] - rows_ptr_[child];
       const int* CR = rows_.data() + rows_ptr_[child];
       const double* Uc = updates[child].get();
+      w.rel.resize(cn);
+      for (int a = 0; a < cn; ++a) w.rel[a] = w.relpos[CR[a]];
+      const int* rel = w.rel.data();
       for (int b = 0; b < cn; ++b) {
-        const int cb = w.relpos[CR[b]];
-        for (int a = b; a < cn; ++a) Fm(w.relpos[CR[a]], cb) += Uc[static_cast<size_t>(b) * cn + a];
+        double* col = w.front.data() + static_cast<size_t>(rel[b]) * m;
+        const double* u = Uc + static_cast<size_t>(b) * cn;
+        for (int a = b; a < cn; ++a) col[rel[a]] += u[a];
       }
       updates[child].reset();
     }
@@ -273,7 +329,11 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
       auto F21 = Fm.bottomLeftCorner(nr, ncols);
       F11.triangularView<Eigen::Lower>().transpose().solveInPlace<Eigen::OnTheRight>(F21);
       auto F22 = Fm.bottomRightCorner(nr, nr);
+#if defined(__wasm_simd128__)
+      sn_rank_update_lower_simd(F22.data(), m, F21.data(), m, nr, ncols, w.pack);
+#else
       F22.selfadjointView<Eigen::Lower>().rankUpdate(F21, -1.0);
+#endif
       updates[s].reset(new double[static_cast<size_t>(nr) * nr]);
       Eigen::Map<Eigen::MatrixXd> Us(updates[s].get(), nr, nr);
       for (int b = 0; b < nr; ++b) Us.col(b).tail(nr - b) = F22.col(b).tail(nr - b);
@@ -292,7 +352,7 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     return ncols * m * m;
   };
   double done_flops = 0, reported = 0;
-  Scratch main_scratch{std::vector<int>(n, -1), {}};
+  Scratch main_scratch{std::vector<int>(n, -1), {}, {}, {}};
   // Supernodes the calling thread factors in order (all of them, or the top of the tree once the
   // subtrees below are done).
   std::vector<int> sequence;
@@ -353,7 +413,7 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
         }
       }
     };
-    Scratch worker_scratch{std::vector<int>(n, -1), {}};
+    Scratch worker_scratch{std::vector<int>(n, -1), {}, {}, {}};
     Status main_status = Status::success();
     Task worker([&] { run(bins[1], worker_scratch, &worker_status); });
     run(bins[0], main_scratch, &main_status);
