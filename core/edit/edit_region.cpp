@@ -122,7 +122,7 @@ Status LaplacianEditor::Impl::build_region(const Eigen::MatrixXd& Vin, const Eig
     return Status::error(StatusCode::InvalidArgument,
                          "the region of interest has no free vertex (every ROI vertex is a handle or fixed)");
 
-  const auto adj = vertex_adjacency(F, n);
+  auto adj = vertex_adjacency(F, n);
   // Faces around the unknowns: complete 1-rings for their Laplacian rows.
   std::vector<int> faces;
   for (int f = 0; f < F.rows(); ++f)
@@ -162,7 +162,7 @@ Status LaplacianEditor::Impl::build_region(const Eigen::MatrixXd& Vin, const Eig
     }
   }
   s->n = n;
-  s->adj = adj;
+  s->adj = std::move(adj);
   s->gid = std::move(gid);
   s->in_roi = std::move(in_roi);
   s->unknown = std::move(unknown);
