@@ -515,13 +515,12 @@ using SnRowMap = Eigen::Map<SnRow<K>>;
 template <int K>
 using SnConstRowMap = Eigen::Map<const SnRow<K>>;
 
-// t = P y: P the nr by ncols panel (column-major, column stride ld), y ncols by K and t nr by K
-// (both row-major). B columns per pass over the rows; every t(a, j) sums its terms in column
-// order.
-template <int K>
-void sn_panel_times(const double* P, long ld, int nr, int ncols, const double* y, double* t) {
+// t += P y, or t −= P y with Subtract: P the nr by ncols panel (column-major, column stride
+// ld), y ncols by K and t nr by K (both row-major). B columns per pass over the rows; every
+// t(a, j) takes its terms in column order.
+template <int K, bool Subtract>
+void sn_panel_update(const double* P, long ld, int nr, int ncols, const double* y, double* t) {
   constexpr int B = sn_panel_block<K>();
-  for (long i = 0; i < static_cast<long>(nr) * K; ++i) t[i] = 0.0;
   int c = 0;
   for (; c + B <= ncols; c += B) {
     const double* p = P + c * ld;
@@ -530,38 +529,32 @@ void sn_panel_times(const double* P, long ld, int nr, int ncols, const double* y
     for (int a = 0; a < nr; ++a) {
       SnRowMap<K> ta(t + static_cast<long>(a) * K);
       SnRow<K> r = ta;
-      for (int q = 0; q < B; ++q) r += p[q * ld + a] * yq[q];
+      for (int q = 0; q < B; ++q) {
+        if constexpr (Subtract)
+          r -= p[q * ld + a] * yq[q];
+        else
+          r += p[q * ld + a] * yq[q];
+      }
       ta = r;
     }
   }
   for (; c < ncols; ++c) {
     const double* pc = P + c * ld;
     const SnRow<K> yc = SnConstRowMap<K>(y + static_cast<long>(c) * K);
-    for (int a = 0; a < nr; ++a) SnRowMap<K>(t + static_cast<long>(a) * K) += pc[a] * yc;
+    for (int a = 0; a < nr; ++a) {
+      if constexpr (Subtract)
+        SnRowMap<K>(t + static_cast<long>(a) * K) -= pc[a] * yc;
+      else
+        SnRowMap<K>(t + static_cast<long>(a) * K) += pc[a] * yc;
+    }
   }
 }
 
-// t −= P y (shapes as above), t(a, j) subtracting in column order.
+// t = P y (shapes as above).
 template <int K>
-void sn_panel_subtract(const double* P, long ld, int nr, int ncols, const double* y, double* t) {
-  constexpr int B = sn_panel_block<K>();
-  int c = 0;
-  for (; c + B <= ncols; c += B) {
-    const double* p = P + c * ld;
-    SnRow<K> yq[B];
-    for (int q = 0; q < B; ++q) yq[q] = SnConstRowMap<K>(y + static_cast<long>(c + q) * K);
-    for (int a = 0; a < nr; ++a) {
-      SnRowMap<K> ta(t + static_cast<long>(a) * K);
-      SnRow<K> r = ta;
-      for (int q = 0; q < B; ++q) r -= p[q * ld + a] * yq[q];
-      ta = r;
-    }
-  }
-  for (; c < ncols; ++c) {
-    const double* pc = P + c * ld;
-    const SnRow<K> yc = SnConstRowMap<K>(y + static_cast<long>(c) * K);
-    for (int a = 0; a < nr; ++a) SnRowMap<K>(t + static_cast<long>(a) * K) -= pc[a] * yc;
-  }
+void sn_panel_times(const double* P, long ld, int nr, int ncols, const double* y, double* t) {
+  for (long i = 0; i < static_cast<long>(nr) * K; ++i) t[i] = 0.0;
+  sn_panel_update<K, false>(P, ld, nr, ncols, y, t);
 }
 
 // y −= Pᵀ t (shapes as above): B columns' sums at once over the rows of t, each summed in row
@@ -604,7 +597,7 @@ void sn_diagonal_solve(const double* D, long ld, int ncols, double* y) {
       for (int r = c + 1; r < ce; ++r) SnRowMap<K>(y + static_cast<long>(r) * K) -= dc[r] * yc;
     }
     if (ce < ncols)
-      sn_panel_subtract<K>(D + cb * ld + ce, ld, ncols - ce, ce - cb, y + static_cast<long>(cb) * K,
+      sn_panel_update<K, true>(D + cb * ld + ce, ld, ncols - ce, ce - cb, y + static_cast<long>(cb) * K,
                            y + static_cast<long>(ce) * K);
   }
 }
