@@ -624,20 +624,22 @@ void SupernodalCholesky::forward_supernode(int s, RowMatrix& Y, RowMatrix& tmp, 
   const int f = start_[s], ncols = start_[s + 1] - f, nr = rows_ptr_[s + 1] - rows_ptr_[s], m = ncols + nr;
   const Eigen::Map<const Eigen::MatrixXd> L(values_.data() + value_ptr_[s], m, ncols);
   auto Ys = Y.middleRows(f, ncols);
-  if (Y.cols() <= kSkinny) {
-    // A few right-hand sides (drags, refinement, the handle basis): plain loops over the
-    // supernode's columns; Eigen's triangular solve and GEMM copy (pack) their operands first,
-    // which cost as much as the products. tmp = L21 Ys in one pass over L21.
+  // A few right-hand sides (drags, refinement, the handle basis): the loops above, with the row
+  // length known at compile time; Eigen's triangular solve and GEMM pack their operands first,
+  // which costs as much as the products here.
+  const bool skinny = Y.cols() <= kSkinny;
+  if (skinny)
+    sn_skinny(static_cast<int>(Y.cols()), [&](auto K) { sn_diagonal_solve<decltype(K)::value>(L.data(), m, ncols, Ys.data()); });
+  else
+    L.topRows(ncols).triangularView<Eigen::Lower>().solveInPlace(Ys);
+  if (nr == 0) return;
+  // tmp = L21 Ys
+  if (skinny) {
+    tmp.resize(nr, Y.cols());
     sn_skinny(static_cast<int>(Y.cols()), [&](auto K) {
-      sn_diagonal_solve<decltype(K)::value>(L.data(), m, ncols, Ys.data());
-      if (nr == 0) return;
-      tmp.resize(nr, Y.cols());
       sn_panel_times<decltype(K)::value>(L.data() + ncols, m, nr, ncols, Ys.data(), tmp.data());
     });
-    if (nr == 0) return;
   } else {
-    L.topRows(ncols).triangularView<Eigen::Lower>().solveInPlace(Ys);
-    if (nr == 0) return;
     tmp.noalias() = L.bottomRows(nr) * Ys;
   }
   const int* R = rows_.data() + rows_ptr_[s];
@@ -655,12 +657,13 @@ void SupernodalCholesky::backward_supernode(int s, RowMatrix& Y, RowMatrix& tmp)
   const int f = start_[s], ncols = start_[s + 1] - f, nr = rows_ptr_[s + 1] - rows_ptr_[s], m = ncols + nr;
   const Eigen::Map<const Eigen::MatrixXd> L(values_.data() + value_ptr_[s], m, ncols);
   auto Ys = Y.middleRows(f, ncols);
+  const bool skinny = Y.cols() <= kSkinny;  // as in forward_supernode
   if (nr > 0) {
     tmp.resize(nr, Y.cols());
     const int* R = rows_.data() + rows_ptr_[s];
     for (int a = 0; a < nr; ++a) tmp.row(a) = Y.row(R[a]);
-    if (Y.cols() <= kSkinny) {
-      // Ys −= L21ᵀ tmp (one pass over the panel, as above).
+    // Ys −= L21ᵀ tmp
+    if (skinny) {
       sn_skinny(static_cast<int>(Y.cols()), [&](auto K) {
         sn_panel_transpose_times<decltype(K)::value>(L.data() + ncols, m, nr, ncols, tmp.data(), Ys.data());
       });
@@ -668,7 +671,7 @@ void SupernodalCholesky::backward_supernode(int s, RowMatrix& Y, RowMatrix& tmp)
       Ys.noalias() -= L.bottomRows(nr).transpose() * tmp;
     }
   }
-  if (Y.cols() <= kSkinny)
+  if (skinny)
     sn_skinny(static_cast<int>(Y.cols()), [&](auto K) {
       sn_diagonal_transpose_solve<decltype(K)::value>(L.data(), m, ncols, Ys.data());
     });
