@@ -228,12 +228,17 @@ std::string transfer_summary(const TransferJobResult& r, const PoseTransferOptio
       s += buf;
     }
     for (const PartReport& p : r.parts.reports) {
+      // The gate's landmark figures (the level's landmark error before and after gluing), when the
+      // part got that far: a part kept or rejected by a hair shows it here.
+      char gate[96] = "";
+      if (p.landmark_error_before > 0 || p.landmark_error_after > 0)
+        std::snprintf(gate, sizeof gate, ", landmark error %.6f -> %.6f", p.landmark_error_before, p.landmark_error_after);
       std::snprintf(buf, sizeof buf,
-                    "    level %d%s %s: %d / %d vertices, %d subdivisions, %d landmarks%s, %s %.1f°, seam dihedral change mean %.1f° max %.1f°, %.0f ms%s%s\n",
+                    "    level %d%s %s: %d / %d vertices, %d subdivisions, %d landmarks%s, %s %.1f°, seam dihedral change mean %.1f° max %.1f°%s, %.0f ms%s%s\n",
                     p.level, p.round > 1 ? (", round " + std::to_string(p.round)).c_str() : "",
                     p.name.empty() ? "(unnamed)" : p.name.c_str(), p.source_vertices, p.reference_vertices,
-                    p.subdivisions, p.landmarks, cage_note(p).c_str(), rigid_note(p).c_str(), p.rotation_degrees, p.seam_dihedral_mean, p.seam_dihedral_max, p.ms,
-                    p.status.ok() ? "" : ", skipped: ", p.status.ok() ? "" : p.status.message.c_str());
+                    p.subdivisions, p.landmarks, cage_note(p).c_str(), rigid_note(p).c_str(), p.rotation_degrees, p.seam_dihedral_mean, p.seam_dihedral_max,
+                    gate, p.ms, p.status.ok() ? "" : ", skipped: ", p.status.ok() ? "" : p.status.message.c_str());
       s += buf;
     }
     std::snprintf(buf, sizeof buf, "  level 1: %d self-intersecting triangle pairs, %s\n",

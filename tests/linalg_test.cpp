@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include <Eigen/Geometry>
@@ -132,6 +133,70 @@ TEST(BlockLanczos, KnownSpectrumWithMultipletsLargerThanTheBlock) {
   o.nev = 200;
   EXPECT_EQ(block_lanczos(n, [&](const Eigen::MatrixXd& X, Eigen::MatrixXd* Y) { *Y = Op * X; return true; }, o).status.code,
             StatusCode::InvalidArgument);
+}
+
+// Eigen's dense matrix × vector products sum in one documented order in every build
+// (core/linalg/wasm_gemv.h): natively Eigen's SSE2 kernels, in wasm our SIMD kernels that replace
+// Eigen's scalar ones. Both are compared bit for bit with plain loops in that order, so native and
+// wasm products give the same bits. Sizes cross Eigen's column blocking (128 columns) and both
+// its strides (a block of a larger matrix), odd and even lengths, and rows left over from the
+// kernels' blocks of 8 and 4.
+TEST(DenseProducts, MatrixVectorSumsInTheDocumentedOrder) {
+#if defined(__AVX__)
+  GTEST_SKIP() << "built with AVX: Eigen's four-lane kernels sum in another order";
+#endif
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const double alpha = 0.7310585786300049;
+  int checked = 0;
+  for (const int ld_extra : {0, 3, 5000}) {
+    for (const int rows : {2, 3, 7, 8, 9, 17, 130}) {
+      for (const int cols : {1, 2, 5, 16, 127, 128, 131, 300}) {
+        Eigen::MatrixXd big(rows + ld_extra, cols);
+        for (Eigen::Index j = 0; j < big.cols(); ++j)
+          for (Eigen::Index i = 0; i < big.rows(); ++i) big(i, j) = u(rng);
+        const auto A = big.topRows(rows);  // outer stride rows + ld_extra
+        Eigen::VectorXd x(cols), xt(rows), y0(rows), y0t(cols);
+        for (auto* v : {&x, &xt, &y0, &y0t})
+          for (Eigen::Index i = 0; i < v->size(); ++i) (*v)(i) = u(rng);
+
+        // Column-major: per row, c = Σ_j A(i,j) x_j over Eigen's column block, then y_i += alpha·c.
+        Eigen::VectorXd y = y0, ref = y0;
+        y.noalias() += alpha * A * x;
+        const Eigen::Index lda = big.outerStride();
+        const int block = cols < 128 ? cols : (lda * static_cast<Eigen::Index>(sizeof(double)) < 32000 ? 16 : 4);
+        for (int j0 = 0; j0 < cols; j0 += block)
+          for (int i = 0; i < rows; ++i) {
+            double c = 0;
+            for (int j = j0; j < std::min(j0 + block, cols); ++j) c = A(i, j) * x(j) + c;
+            ref(i) = c * alpha + ref(i);
+          }
+        for (int i = 0; i < rows; ++i)
+          ASSERT_EQ(y(i), ref(i)) << "A x, " << rows << " x " << cols << " stride " << lda << ", row " << i;
+
+        // Row-major (Aᵀ x): per row, even and odd partial sums, added, the odd tail, y_i += alpha·c.
+        // (One column makes Aᵀ a single row: Eigen takes that as a dot product, not a GEMV.)
+        ++checked;
+        if (cols == 1) continue;
+        Eigen::VectorXd yt = y0t, reft = y0t;
+        yt.noalias() += alpha * A.transpose() * xt;
+        for (int i = 0; i < cols; ++i) {
+          double s0 = 0, s1 = 0;
+          int j = 0;
+          for (; j + 2 <= rows; j += 2) {
+            s0 = A(j, i) * xt(j) + s0;
+            s1 = A(j + 1, i) * xt(j + 1) + s1;
+          }
+          double c = s0 + s1;
+          for (; j < rows; ++j) c += A(j, i) * xt(j);
+          reft(i) += alpha * c;
+        }
+        for (int i = 0; i < cols; ++i)
+          ASSERT_EQ(yt(i), reft(i)) << "A' x, " << cols << " x " << rows << " stride " << lda << ", row " << i;
+      }
+    }
+  }
+  EXPECT_EQ(checked, 3 * 7 * 8);
 }
 
 }  // namespace mm
