@@ -34,11 +34,11 @@ add_library(mm_eigen INTERFACE)
 target_include_directories(mm_eigen SYSTEM INTERFACE ${MM_SHIM})
 target_compile_definitions(mm_eigen INTERFACE EIGEN_MPL2_ONLY)
 if(EMSCRIPTEN)
-  # Eigen's double GEMV has wasm SIMD kernels of ours (core/linalg/wasm_gemv.h): the explicit
+  # Eigen's double GEMV has wasm SIMD kernels of ours (core/linalg/wasm_eigen_kernels.h): the explicit
   # specialisations must be declared before any use, so every C++ TU that sees Eigen includes the
   # declarations first.
   target_compile_options(mm_eigen INTERFACE
-    "$<$<COMPILE_LANGUAGE:CXX>:SHELL:-include ${PROJECT_SOURCE_DIR}/core/linalg/wasm_gemv.h>")
+    "$<$<COMPILE_LANGUAGE:CXX>:SHELL:-include ${PROJECT_SOURCE_DIR}/core/linalg/wasm_eigen_kernels.h>")
 endif()
 add_library(mm::eigen ALIAS mm_eigen)
 

@@ -135,12 +135,11 @@ TEST(BlockLanczos, KnownSpectrumWithMultipletsLargerThanTheBlock) {
             StatusCode::InvalidArgument);
 }
 
-// Eigen's dense matrix × vector products sum in one documented order in every build
-// (core/linalg/wasm_gemv.h): natively Eigen's SSE2 kernels, in wasm our SIMD kernels that replace
-// Eigen's scalar ones. Both are compared bit for bit with plain loops in that order, so native and
-// wasm products give the same bits. Sizes cross Eigen's column blocking (128 columns) and both
-// its strides (a block of a larger matrix), odd and even lengths, and rows left over from the
-// kernels' blocks of 8 and 4.
+// Eigen's dense matrix × vector products sum in a documented order in each build
+// (core/linalg/wasm_eigen_kernels.h): natively Eigen's SSE2 kernels, in wasm our SIMD kernels that
+// replace Eigen's scalar ones and keep their order. Compared bit for bit with plain loops in that
+// order. Sizes cross Eigen's column blocking (128 columns) and both its strides (a block of a
+// larger matrix), odd and even lengths, and rows left over from the kernels' blocks of 8 and 4.
 TEST(DenseProducts, MatrixVectorSumsInTheDocumentedOrder) {
 #if defined(__AVX__)
   GTEST_SKIP() << "built with AVX: Eigen's four-lane kernels sum in another order";
@@ -174,13 +173,19 @@ TEST(DenseProducts, MatrixVectorSumsInTheDocumentedOrder) {
         for (int i = 0; i < rows; ++i)
           ASSERT_EQ(y(i), ref(i)) << "A x, " << rows << " x " << cols << " stride " << lda << ", row " << i;
 
-        // Row-major (Aᵀ x): per row, even and odd partial sums, added, the odd tail, y_i += alpha·c.
-        // (One column makes Aᵀ a single row: Eigen takes that as a dot product, not a GEMV.)
+        // Row-major (Aᵀ x): natively (SSE2's two lanes) per row even and odd partial sums, added,
+        // the odd tail; in wasm one sum in order (Eigen's scalar order, which our kernel keeps);
+        // then y_i += alpha·c. (One column makes Aᵀ a single row: Eigen takes that as a dot
+        // product, not a GEMV.)
         ++checked;
         if (cols == 1) continue;
         Eigen::VectorXd yt = y0t, reft = y0t;
         yt.noalias() += alpha * A.transpose() * xt;
         for (int i = 0; i < cols; ++i) {
+#if defined(__EMSCRIPTEN__)
+          double c = 0;
+          for (int j = 0; j < rows; ++j) c = A(j, i) * xt(j) + c;
+#else
           double s0 = 0, s1 = 0;
           int j = 0;
           for (; j + 2 <= rows; j += 2) {
@@ -189,6 +194,7 @@ TEST(DenseProducts, MatrixVectorSumsInTheDocumentedOrder) {
           }
           double c = s0 + s1;
           for (; j < rows; ++j) c += A(j, i) * xt(j);
+#endif
           reft(i) += alpha * c;
         }
         for (int i = 0; i < cols; ++i)
@@ -197,6 +203,53 @@ TEST(DenseProducts, MatrixVectorSumsInTheDocumentedOrder) {
     }
   }
   EXPECT_EQ(checked, 3 * 7 * 8);
+}
+
+// In wasm, Eigen's matrix × matrix micro-kernel is ours too (core/linalg/wasm_eigen_kernels.h) and
+// keeps the order of Eigen's scalar kernel: per entry, the even and odd k of the peeled part (a
+// multiple of 8) in two sums, added, the remaining k, then c·alpha added to the entry (four
+// columns at a time; a fifth, sixth... column in one sum). Checked bit for bit at depths that fit
+// one of Eigen's depth blocks. (Natively Eigen's SSE2 kernel blocks the sums differently.)
+TEST(DenseProducts, WasmMatrixProductKeepsTheScalarKernelsOrder) {
+#if !defined(__EMSCRIPTEN__)
+  GTEST_SKIP() << "native build: Eigen's own vectorised kernel";
+#else
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const double alpha = -0.4142135623730951;
+  int checked = 0;
+  for (const int m : {2, 3, 9, 33})
+    for (const int k : {2, 7, 8, 13, 16, 40, 64})
+      for (const int n : {2, 4, 6, 9, 17}) {
+        // Below 20 (k + m + n) Eigen evaluates the product coefficient by coefficient instead.
+        if (m + k + n < 20) continue;
+        Eigen::MatrixXd A(m, k), B(k, n), C0(m, n);
+        for (auto* M : {&A, &B, &C0})
+          for (Eigen::Index i = 0; i < M->size(); ++i) M->data()[i] = u(rng);
+        Eigen::MatrixXd C = C0;
+        C.noalias() += alpha * A * B;
+        const int peeled = k & ~7, packet_cols = (n / 4) * 4;
+        for (int j = 0; j < n; ++j)
+          for (int i = 0; i < m; ++i) {
+            double c = 0;
+            if (j < packet_cols) {
+              double d = 0;
+              for (int q = 0; q < peeled; q += 2) {
+                c = c + A(i, q) * B(q, j);
+                d = d + A(i, q + 1) * B(q + 1, j);
+              }
+              c = c + d;
+              for (int q = peeled; q < k; ++q) c = c + A(i, q) * B(q, j);
+            } else {
+              for (int q = 0; q < k; ++q) c = c + A(i, q) * B(q, j);
+            }
+            const double ref = c * alpha + C0(i, j);
+            ASSERT_EQ(C(i, j), ref) << m << " x " << k << " x " << n << " at (" << i << ", " << j << ")";
+          }
+        ++checked;
+      }
+  EXPECT_EQ(checked, 109);
+#endif
 }
 
 }  // namespace mm

@@ -39,8 +39,6 @@ double ray_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& dir, const 
   const Eigen::Vector3d e1 = b - a, e2 = c - a;
   const Eigen::Vector3d h = dir.cross(e2);
   const double det = e1.dot(h);
-  const double scale = e1.norm() * e2.norm() * dir.norm();
-  if (std::abs(det) <= 1e-14 * scale) return -1;  // parallel or degenerate triangle
   const double inv = 1.0 / det;
   const Eigen::Vector3d s = p - a;
   const double u = s.dot(h) * inv;
@@ -48,6 +46,11 @@ double ray_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& dir, const 
   const Eigen::Vector3d q = s.cross(e1);
   const double v = dir.dot(q) * inv;
   if (v < 0.0 || u + v > 1.0) return -1;
+  // Parallel or degenerate triangle. Tested after the cheap rejections (most triangles a ray's
+  // boxes reach miss it), so the three square roots are paid only by hits; the result is the
+  // same (with det = 0, u and v are ±inf or NaN and pass or fail the tests above, then fail here).
+  const double scale = e1.norm() * e2.norm() * dir.norm();
+  if (std::abs(det) <= 1e-14 * scale) return -1;
   const double t = e2.dot(q) * inv;
   // det = e1·(dir×e2) = dir·(e2×e1) = -dir·n, so the sign is flipped for dot(n, dir).
   *det_sign = det > 0 ? -1 : 1;
@@ -223,10 +226,15 @@ bool TriangleBvh::inside(const Eigen::Vector3d& p) const {
                                     {0.1118, -0.8944, 0.4331}, {-0.7771, -0.2213, 0.5893},
                                     {0.8163, -0.3397, -0.4671}, {-0.2041, 0.9613, -0.1848},
                                     {0.3015, 0.0745, -0.9505}};
+  // Majority of the seven rays, stopping as soon as the majority is decided (same answer; a
+  // point clearly inside or outside casts four rays instead of seven).
   int votes = 0;
-  for (const auto& d : dirs)
-    if (std::abs(ray_winding(p, Eigen::Vector3d(d[0], d[1], d[2]))) >= 1) ++votes;
-  return votes >= 4;
+  for (int r = 0; r < 7; ++r) {
+    if (std::abs(ray_winding(p, Eigen::Vector3d(dirs[r][0], dirs[r][1], dirs[r][2]))) >= 1) ++votes;
+    if (votes >= 4) return true;
+    if (votes + (6 - r) < 4) return false;
+  }
+  return false;
 }
 
 bool TriangleBvh::segment_hits(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
