@@ -229,7 +229,7 @@ TEST(SpatialGrid, PointGridBoxQueriesMatchBruteForce) {
   EXPECT_TRUE(mm::PointGrid(Eigen::MatrixXd(0, 3)).for_each_in_box(all_lo, all_hi, [](int) { return false; }));
 }
 
-TEST(SpatialGrid, BoxGridFilesEntriesUnderOverlappedCellsAndPrunesStale) {
+TEST(SpatialGrid, BoxGridReportsEachEntryOnceAndRemovesIt) {
   mm::UniformGrid g;
   g.cell = 1;
   g.dims[0] = g.dims[1] = g.dims[2] = 4;  // [0, 4)³; outside coordinates clamp to the border
@@ -238,23 +238,35 @@ TEST(SpatialGrid, BoxGridFilesEntriesUnderOverlappedCellsAndPrunesStale) {
   EXPECT_EQ(g.coord(9.0, 2), 3);
   mm::BoxGrid<int> bg;
   bg.reset(g);
-  auto never = [](int) { return false; };
-  bg.insert(Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(1.5, 0.5, 0.5), 7, never);  // cells (0..1, 0, 0)
-  bg.insert(Eigen::Vector3d(3.5, 3.5, 3.5), Eigen::Vector3d(3.6, 3.6, 3.6), 9, never);  // cell (3, 3, 3)
+  const auto r7 = bg.range(Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(1.5, 1.5, 0.5));  // cells (0..1, 0..1, 0)
+  EXPECT_EQ(r7.lo[0], 0);
+  EXPECT_EQ(r7.hi[0], 1);
+  EXPECT_EQ(r7.hi[1], 1);
+  EXPECT_EQ(r7.hi[2], 0);
+  bg.insert(r7, 7);
+  bg.insert(bg.range(Eigen::Vector3d(3.5, 3.5, 3.5), Eigen::Vector3d(9.0, 9.0, 9.0)), 9);  // cell (3, 3, 3)
+  bg.insert(bg.range(Eigen::Vector3d(-1.0, 0.2, 0.2), Eigen::Vector3d(5.0, 0.3, 0.3)), 5);  // a row of 4 cells
   auto collect = [&](const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
     std::vector<int> out;
     bg.for_each_in_box(lo, hi, [&](int e) {
       out.push_back(e);
       return true;
     });
+    std::sort(out.begin(), out.end());
     return out;
   };
-  EXPECT_EQ(collect(Eigen::Vector3d(1.2, 0.1, 0.1), Eigen::Vector3d(1.3, 0.2, 0.2)), std::vector<int>{7});
-  EXPECT_EQ(collect(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(4, 4, 4)), (std::vector<int>{7, 7, 9}));
+  // An entry filed under several cells is reported once, whichever of its cells the box covers.
+  EXPECT_EQ(collect(Eigen::Vector3d(1.2, 0.1, 0.1), Eigen::Vector3d(1.3, 0.2, 0.2)), (std::vector<int>{5, 7}));
+  EXPECT_EQ(collect(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(4, 4, 4)), (std::vector<int>{5, 7, 9}));
+  EXPECT_EQ(collect(Eigen::Vector3d(1.1, 1.1, 0.1), Eigen::Vector3d(3.9, 3.9, 0.1)), (std::vector<int>{7}));
+  EXPECT_EQ(collect(Eigen::Vector3d(2.5, 0.5, 0.5), Eigen::Vector3d(3.5, 0.5, 0.5)), (std::vector<int>{5}));
   EXPECT_TRUE(collect(Eigen::Vector3d(2.1, 2.1, 2.1), Eigen::Vector3d(2.2, 2.2, 2.2)).empty());
-  // 16 entries in one cell, then the 17th insert prunes the stale (odd) ones first.
-  for (int e = 0; e < 16; ++e) bg.insert(Eigen::Vector3d(2.5, 2.5, 2.5), Eigen::Vector3d(2.5, 2.5, 2.5), e, never);
-  bg.insert(Eigen::Vector3d(2.5, 2.5, 2.5), Eigen::Vector3d(2.5, 2.5, 2.5), 100, [](int e) { return e % 2 == 1; });
-  const std::vector<int> cell = collect(Eigen::Vector3d(2.5, 2.5, 2.5), Eigen::Vector3d(2.5, 2.5, 2.5));
-  EXPECT_EQ(cell, (std::vector<int>{0, 2, 4, 6, 8, 10, 12, 14, 100}));
+  // The search stops at the first false.
+  int calls = 0;
+  EXPECT_FALSE(bg.for_each_in_box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(4, 4, 4), [&](int) { return ++calls < 2; }));
+  EXPECT_EQ(calls, 2);
+  // Removal takes the entry out of every cell it was filed under, and only that entry.
+  bg.remove(r7, [](int e) { return e == 7; });
+  EXPECT_EQ(collect(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(4, 4, 4)), (std::vector<int>{5, 9}));
+  EXPECT_EQ(collect(Eigen::Vector3d(1.1, 1.1, 0.1), Eigen::Vector3d(1.2, 1.2, 0.2)), std::vector<int>{});
 }

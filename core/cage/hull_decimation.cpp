@@ -50,12 +50,27 @@ class EdgeHeap {
       i = parent;
     }
   }
+  size_t size() const { return h_.size(); }
+  // Drops the entries `stale` names and restores the heap order bottom-up (O(size)); pops of the
+  // kept entries come out in the same order as before (the order is total on (cost, a, b)).
+  template <class Stale>
+  void compact(Stale stale) {
+    h_.erase(std::remove_if(h_.begin(), h_.end(), stale), h_.end());
+    const size_t n = h_.size();
+    if (n < 2) return;
+    for (size_t i = (n - 2) / 4 + 1; i-- > 0;) sift_down(i);
+  }
   HeapEntry pop() {
     const HeapEntry top = h_[0];
     h_[0] = h_.back();
     h_.pop_back();
+    sift_down(0);
+    return top;
+  }
+
+ private:
+  void sift_down(size_t i) {
     const size_t n = h_.size();
-    size_t i = 0;
     for (;;) {
       const size_t first = 4 * i + 1;
       if (first >= n) break;
@@ -67,10 +82,8 @@ class EdgeHeap {
       std::swap(h_[i], h_[best]);
       i = best;
     }
-    return top;
   }
 
- private:
   std::vector<HeapEntry> h_;
 };
 
@@ -121,8 +134,8 @@ class Decimator {
     alive_vertices_ = 0;
     for (int i = 0; i < n; ++i) alive_vertices_ += vert_alive_[i];
     alive_faces_ = static_cast<int>(F.rows());
-    stamp_.assign(F.rows(), 0);
-    face_version_.assign(F.rows(), 0);
+    face_range_.resize(F.rows());
+    in_grid_.assign(F.rows(), 0);
     cos_turn_ = std::cos(opt_.max_normal_turn_deg * kPi / 180.0);
   }
 
@@ -130,12 +143,20 @@ class Decimator {
     rebuild_grid();
     for (int a = 0; a < static_cast<int>(pos_.size()); ++a) {
       if (!vert_alive_[a]) continue;
-      for (int b : neighbours(a))
+      neighbours(a, &scratch_[0]);
+      for (int b : scratch_[0])
         if (a < b) push(a, b);
     }
     const int start = alive_vertices_;
     int done = 0;
     while (alive_vertices_ > opt_.target_vertices && !heap_.empty()) {
+      // Every collapse leaves the entries of the edges around both ends stale (~10): once they
+      // outnumber the live edges (≤ 3 per vertex on a closed surface plus a margin), drop them,
+      // so that pops stop paying for stale entries in a heap several times too deep.
+      if (heap_.size() > 6 * static_cast<size_t>(alive_vertices_) + 64)
+        heap_.compact([&](const HeapEntry& h) {
+          return !vert_alive_[h.a] || !vert_alive_[h.b] || h.va != version_[h.a] || h.vb != version_[h.b];
+        });
       const HeapEntry e = heap_.pop();
       if (!vert_alive_[e.a] || !vert_alive_[e.b]) continue;
       // The cost depends only on the state of a and b; when either changed, a fresh entry was
@@ -188,24 +209,24 @@ class Decimator {
     return list;
   }
 
-  std::vector<int> neighbours(int v) {
-    std::vector<int> out;
+  // The neighbours of v, ascending, into *out (a reused buffer: this runs several times per
+  // collapse, and allocating was a tenth of the decimation's time).
+  void neighbours(int v, std::vector<int>* out) {
+    out->clear();
     for (int f : faces_of(v))
       for (int c = 0; c < 3; ++c)
-        if (faces_[f][c] != v) out.push_back(faces_[f][c]);
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    return out;
+        if (faces_[f][c] != v) out->push_back(faces_[f][c]);
+    std::sort(out->begin(), out->end());
+    out->erase(std::unique(out->begin(), out->end()), out->end());
   }
 
   static bool has_vertex(const std::array<int, 3>& t, int v) { return t[0] == v || t[1] == v || t[2] == v; }
 
-  // Faces around a or b, each once (edge faces included).
-  std::vector<int> star(int a, int b) {
-    std::vector<int> s = faces_of(a);
+  // Faces around a or b, each once (edge faces included), into *s.
+  void star(int a, int b, std::vector<int>* s) {
+    *s = faces_of(a);
     for (int f : faces_of(b))
-      if (!has_vertex(faces_[f], a)) s.push_back(f);
-    return s;
+      if (!has_vertex(faces_[f], a)) s->push_back(f);
   }
 
   // Up to four positions for the merged vertex (quadric minimiser, midpoint, endpoints),
@@ -250,25 +271,34 @@ class Decimator {
 
   bool collapse(int a, int b, const Candidates& cands) {
     // Link condition: the common neighbours of a and b are exactly the two opposite vertices.
-    std::vector<int> edge_faces;
+    int edge_faces[2], n_edge_faces = 0;
     for (int f : faces_of(a))
-      if (has_vertex(faces_[f], b)) edge_faces.push_back(f);
-    if (edge_faces.size() != 2) return false;
+      if (has_vertex(faces_[f], b) && n_edge_faces++ < 2) edge_faces[n_edge_faces - 1] = f;
+    if (n_edge_faces != 2) return false;
     int opposite[2];
     for (int k = 0; k < 2; ++k) {
       const auto& t = faces_[edge_faces[k]];
       opposite[k] = t[0] != a && t[0] != b ? t[0] : (t[1] != a && t[1] != b ? t[1] : t[2]);
     }
     if (opposite[0] == opposite[1]) return false;
-    const std::vector<int> na = neighbours(a), nb = neighbours(b);
-    std::vector<int> common;
-    std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
-    if (common.size() != 2) return false;
+    std::vector<int>&na = scratch_[0], &nb = scratch_[1], &other = scratch_[2];
+    neighbours(a, &na);
+    neighbours(b, &nb);
+    size_t common = 0;  // |na ∩ nb| (both ascending)
+    for (size_t i = 0, j = 0; i < na.size() && j < nb.size();) {
+      if (na[i] < nb[j]) ++i;
+      else if (nb[j] < na[i]) ++j;
+      else ++common, ++i, ++j;
+    }
+    if (common != 2) return false;
     if (static_cast<int>(na.size() + nb.size()) - 4 < 3) return false;
-    for (int k = 0; k < 2; ++k)
-      if (neighbours(opposite[k]).size() <= 3) return false;
+    for (int k = 0; k < 2; ++k) {
+      neighbours(opposite[k], &other);
+      if (other.size() <= 3) return false;
+    }
 
-    const std::vector<int> s = star(a, b);
+    std::vector<int>& s = scratch_[3];
+    star(a, b, &s);
     for (int k = 0; k < cands.n; ++k)
       if (valid_position(a, b, s, cands.p[k])) {
         apply(a, b, edge_faces, cands.p[k]);
@@ -280,8 +310,11 @@ class Decimator {
   // Geometry tests of moving a and b to p: no flipped or degenerate face, no self-intersection,
   // no point leaving the surface or coming closer than the clearance.
   bool valid_position(int a, int b, const std::vector<int>& s, const Vec3& p) {
-    std::vector<std::array<Vec3, 3>> moved, old;
-    std::vector<std::array<int, 3>> moved_ids;
+    std::vector<std::array<Vec3, 3>>&moved = moved_, &old = old_;
+    std::vector<std::array<int, 3>>& moved_ids = moved_ids_;
+    moved.clear();
+    old.clear();
+    moved_ids.clear();
     Vec3 lo = p, hi = p;
     double largest = 0;
     for (int f : s) largest = std::max(largest, norm(face_area_vector(f)));
@@ -329,8 +362,11 @@ class Decimator {
     });
   }
 
-  void apply(int a, int b, const std::vector<int>& edge_faces, const Vec3& p) {
-    for (int f : edge_faces) face_alive_[f] = 0;
+  void apply(int a, int b, const int edge_faces[2], const Vec3& p) {
+    for (int k = 0; k < 2; ++k) {
+      face_alive_[edge_faces[k]] = 0;
+      grid_remove(edge_faces[k]);
+    }
     alive_faces_ -= 2;
     pos_[a] = p;
     ++version_[a];
@@ -347,7 +383,9 @@ class Decimator {
     std::sort(list.begin(), list.end());
     list.erase(std::unique(list.begin(), list.end()), list.end());
     for (int f : faces_of(a)) grid_insert(f);
-    for (int x : neighbours(a)) push(std::min(a, x), std::max(a, x));
+    std::vector<int>& na = scratch_[0];
+    neighbours(a, &na);
+    for (int x : na) push(std::min(a, x), std::max(a, x));
   }
 
   // --- uniform grid over face bounding boxes, rebuilt as faces grow ---
@@ -377,6 +415,7 @@ class Decimator {
       g.dims[k] = static_cast<int>(std::ceil((ext[k] + 2 * cs) / cs)) + 1;
     }
     face_grid_.reset(g);
+    std::fill(in_grid_.begin(), in_grid_.end(), 0);
     for (size_t f = 0; f < faces_.size(); ++f)
       if (face_alive_[f]) grid_insert(static_cast<int>(f));
     grid_faces_ = alive_faces_;
@@ -403,18 +442,24 @@ class Decimator {
     }
   }
 
+  // Files face f under its current box (first dropping its earlier copies); a face that moved
+  // is filed again, a face that died only dropped, so the grid holds every alive face once.
   void grid_insert(int f) {
+    grid_remove(f);
+    if (!face_alive_[f]) return;
     Vec3 lo, hi;
     bbox(face_points(f), &lo, &hi);
     CellEntry e;
     e.f = f;
-    e.version = ++face_version_[f];
     float_box(lo, hi, e.lo, e.hi);
-    // Faces are re-inserted after every change: dead and superseded entries are dropped as
-    // cells grow, so cells stay short.
-    face_grid_.insert(lo, hi, e, [&](const CellEntry& c) {
-      return !face_alive_[c.f] || c.version != face_version_[c.f];
-    });
+    face_range_[f] = face_grid_.range(lo, hi);
+    face_grid_.insert(face_range_[f], e);
+    in_grid_[f] = 1;
+  }
+  void grid_remove(int f) {
+    if (!in_grid_[f]) return;
+    face_grid_.remove(face_range_[f], [f](const CellEntry& c) { return c.f == f; });
+    in_grid_[f] = 0;
   }
 
   // True when one of the moved faces crosses a face that shares no vertex with it. One grid
@@ -422,23 +467,22 @@ class Decimator {
   bool hits_other_face(const std::vector<std::array<Vec3, 3>>& moved, const std::vector<std::array<int, 3>>& ids,
                        int a, int b) {
     if (moved.empty()) return false;
-    std::vector<Vec3> mlo(moved.size()), mhi(moved.size());
+    std::vector<Vec3>&mlo = mlo_, &mhi = mhi_;
+    mlo.resize(moved.size());
+    mhi.resize(moved.size());
     Vec3 lo, hi;
     for (size_t k = 0; k < moved.size(); ++k) {
       bbox(moved[k], &mlo[k], &mhi[k]);
       lo = k == 0 ? mlo[k] : Vec3(std::min(lo.x, mlo[k].x), std::min(lo.y, mlo[k].y), std::min(lo.z, mlo[k].z));
       hi = k == 0 ? mhi[k] : Vec3(std::max(hi.x, mhi[k].x), std::max(hi.y, mhi[k].y), std::max(hi.z, mhi[k].z));
     }
-    ++query_;
     // The entry's stored box (rounded outward) rejects most candidates without touching the
-    // face arrays; superseded entries (the face moved since) are skipped.
+    // face arrays (the grid holds each alive face once, under its current box).
     const bool clear = face_grid_.for_each_in_box(lo, hi, [&](const CellEntry& ce) {
       if (ce.lo[0] > hi.x || ce.lo[1] > hi.y || ce.lo[2] > hi.z || ce.hi[0] < lo.x || ce.hi[1] < lo.y ||
           ce.hi[2] < lo.z)
         return true;
       const int g = ce.f;
-      if (ce.version != face_version_[g] || stamp_[g] == query_ || !face_alive_[g]) return true;
-      stamp_[g] = query_;
       const auto& t = faces_[g];
       if (has_vertex(t, a) || has_vertex(t, b)) return true;  // part of the star
       const auto Q = face_points(g);
@@ -460,6 +504,11 @@ class Decimator {
   }
 
   HullDecimationOptions opt_;
+  // Buffers reused across collapses (contents meaningful only inside one call).
+  std::vector<int> scratch_[4];
+  std::vector<std::array<Vec3, 3>> moved_, old_;
+  std::vector<std::array<int, 3>> moved_ids_;
+  std::vector<Vec3> mlo_, mhi_;
   const Eigen::MatrixXd& point_pos_;  // the points to keep inside (rows)
   PointGrid points_;
   double clearance_ = 0;
@@ -475,13 +524,11 @@ class Decimator {
   int alive_vertices_ = 0, alive_faces_ = 0, grid_faces_ = 0;
   struct CellEntry {
     int f;
-    unsigned version;    // face_version_[f] when inserted
     float lo[3], hi[3];  // bounding box of the face then, rounded outward
   };
   BoxGrid<CellEntry> face_grid_;  // faces by bounding box, rebuilt as faces grow
-  std::vector<unsigned> face_version_;
-  std::vector<unsigned> stamp_;
-  unsigned query_ = 0;
+  std::vector<BoxGrid<CellEntry>::Range> face_range_;  // per face: the cells holding it (when in_grid_)
+  std::vector<uint8_t> in_grid_;
 };
 
 }  // namespace hull_detail

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -85,45 +86,83 @@ class PointGrid {
   std::vector<int> start_, ids_;  // cell c holds ids_[start_[c] .. start_[c + 1])
 };
 
-// Entries of type Entry filed under every cell their bounding box overlaps.
+// Entries of type Entry filed under every cell their bounding box overlaps (grids of at most
+// 65,535 cells along each axis). Each copy keeps the entry's cell range: a query reports an entry
+// once, from the first cell where its range and the query's overlap (no visited set), and an
+// entry can be removed from exactly the cells that hold it.
 template <class Entry>
 class BoxGrid {
  public:
-  // Empties the grid and sets its geometry.
+  struct Range {
+    uint16_t lo[3], hi[3];
+  };
+
   void reset(const UniformGrid& grid) {
     grid_ = grid;
     cells_.assign(grid_.num_cells(), {});
   }
   const UniformGrid& grid() const { return grid_; }
 
-  // Files e under the cells overlapping [blo, bhi]. Before appending to a cell whose length is
-  // a power of two ≥ 16, drops its entries for which stale(entry) is true, so that cells of
-  // items inserted again after every change stay short.
-  template <class Vec, class Stale>
-  void insert(const Vec& blo, const Vec& bhi, const Entry& e, Stale stale) {
-    grid_.for_each_cell(blo, bhi, [&](size_t c) {
-      auto& cell = cells_[c];
-      if (cell.size() >= 16 && (cell.size() & (cell.size() - 1)) == 0)
-        cell.erase(std::remove_if(cell.begin(), cell.end(), stale), cell.end());
-      cell.push_back(e);
-      return true;
+  template <class Vec>
+  Range range(const Vec& blo, const Vec& bhi) const {
+    int r0[3], r1[3];
+    grid_.cell_range(blo, bhi, r0, r1);
+    Range r;
+    for (int k = 0; k < 3; ++k) {
+      r.lo[k] = static_cast<uint16_t>(r0[k]);
+      r.hi[k] = static_cast<uint16_t>(r1[k]);
+    }
+    return r;
+  }
+
+  void insert(const Range& r, const Entry& e) {
+    for_cells(r, [&](std::vector<Stored>& cell) { cell.push_back({e, r}); });
+  }
+
+  // Removes, from each cell of r, the first copy `match` accepts (cell order is not kept).
+  template <class Match>
+  void remove(const Range& r, Match match) {
+    for_cells(r, [&](std::vector<Stored>& cell) {
+      for (size_t i = 0; i < cell.size(); ++i)
+        if (match(cell[i].e)) {
+          cell[i] = cell.back();
+          cell.pop_back();
+          return;
+        }
     });
   }
 
-  // Calls fn(entry) for the entries of every cell overlapping [blo, bhi] (an entry spanning
-  // several cells is seen once per cell); stops and returns false as soon as fn does.
+  // fn(entry) once for every entry filed under a cell the box overlaps; stops at the first false.
   template <class Vec, class Fn>
   bool for_each_in_box(const Vec& blo, const Vec& bhi, Fn fn) const {
-    return grid_.for_each_cell(blo, bhi, [&](size_t c) {
-      for (const Entry& e : cells_[c])
-        if (!fn(e)) return false;
-      return true;
-    });
+    const Range q = range(blo, bhi);
+    for (int z = q.lo[2]; z <= q.hi[2]; ++z)
+      for (int y = q.lo[1]; y <= q.hi[1]; ++y)
+        for (int x = q.lo[0]; x <= q.hi[0]; ++x)
+          for (const Stored& s : cells_[grid_.index(x, y, z)]) {
+            // Reported from the first cell of the overlap only.
+            if (std::max(s.r.lo[0], q.lo[0]) != x || std::max(s.r.lo[1], q.lo[1]) != y ||
+                std::max(s.r.lo[2], q.lo[2]) != z)
+              continue;
+            if (!fn(s.e)) return false;
+          }
+    return true;
   }
 
  private:
+  struct Stored {
+    Entry e;
+    Range r;
+  };
+  template <class Fn>
+  void for_cells(const Range& r, Fn fn) {
+    for (int z = r.lo[2]; z <= r.hi[2]; ++z)
+      for (int y = r.lo[1]; y <= r.hi[1]; ++y)
+        for (int x = r.lo[0]; x <= r.hi[0]; ++x) fn(cells_[grid_.index(x, y, z)]);
+  }
+
   UniformGrid grid_;
-  std::vector<std::vector<Entry>> cells_;
+  std::vector<std::vector<Stored>> cells_;
 };
 
 }  // namespace mm
