@@ -1,5 +1,8 @@
 // Joins the rows of meshmorph_bench --json runs into one Markdown table:
 //   node scripts/bench-table.mjs NATIVE.json WASM.json [--native-threads F.json] [--wasm-threads F.json]
+// Each file may be a comma-separated list of repeated runs (scripts/bench --repeat N, native and
+// wasm alternating): each row then shows its fastest run, which keeps a machine's drift between
+// the native and the wasm runs out of the ratios.
 // NATIVE and WASM are one-thread runs (the single-threaded wasm build); the optional files are the
 // native run with --threads N and the threaded wasm build's run with --threads N (scripts/bench
 // --threads N). wasm/native compares one thread with one thread; wasm N/native 1 is the figure the
@@ -15,6 +18,21 @@ export function peerMs(text) {
   return m[2] === 's' ? total * 1000 : total;
 }
 
+// Rows of one or more runs ("a.json,b.json"): per row (suite, mesh, stage) the fastest run's.
+export function fastestRows(runs) {
+  const key = (r) => `${r.suite}|${r.mesh}|${r.stage}`;
+  const best = new Map();
+  const order = [];
+  for (const rows of runs)
+    for (const r of rows) {
+      const k = key(r);
+      const b = best.get(k);
+      if (!b) order.push(k);
+      if (!b || r.ms < b.ms) best.set(k, r);
+    }
+  return order.map((k) => best.get(k));
+}
+
 function main(argv) {
   const positional = [];
   const named = {};
@@ -22,7 +40,7 @@ function main(argv) {
     if (argv[i].startsWith('--')) named[argv[i].slice(2)] = argv[++i];
     else positional.push(argv[i]);
   }
-  const read = (f) => (f ? JSON.parse(readFileSync(f, 'utf8')) : null);
+  const read = (f) => (f ? fastestRows(f.split(',').map((one) => JSON.parse(readFileSync(one, 'utf8')))) : null);
   const [native, wasm] = positional.map(read);
   const nativeN = read(named['native-threads']);
   const wasmN = read(named['wasm-threads']);

@@ -123,6 +123,43 @@ TEST(CageMvc, PointsNearAndOnFacesAndVertices) {
   EXPECT_NEAR(m.Psi(P.rows() - 1, 6), 1.0, 1e-15);
 }
 
+// Points are computed two at a time (one per SIMD lane) where the build has SIMD: every row
+// must have the bits of the same point computed alone, also when the pair's other point sits on
+// a cage vertex or in a face's plane (such pairs are redone one point at a time), and on a
+// real cage.
+TEST(CageMvc, PairedRowsEqualOnePointAtATime) {
+  Eigen::MatrixXd C;
+  Eigen::MatrixXi CF;
+  cage_test::cube(&C, &CF);
+  Eigen::MatrixXd P = cage_test::points_in_unit_cube(40);
+  P.row(3) << 1.0, 1.0, 1.0;    // a cage vertex, paired with row 2
+  P.row(6) << 0.3, 0.7, 0.0;    // on the bottom face, paired with row 7
+  P.row(9) << 0.3, 0.7, 1e-13;  // within 1e-10 of the face's plane
+  auto alone = [](const Eigen::MatrixXd& pts, const Eigen::MatrixXd& cv, const Eigen::MatrixXi& cf) {
+    Eigen::MatrixXd rows(pts.rows(), cv.rows());
+    for (int i = 0; i < pts.rows(); ++i) {
+      const MeanValueCoordinates one = mean_value_coordinates(pts.row(i), cv, cf);
+      EXPECT_TRUE(one.status.ok()) << one.status.message;
+      rows.row(i) = one.Psi;
+    }
+    return rows;
+  };
+  const MeanValueCoordinates all = mean_value_coordinates(P, C, CF);
+  ASSERT_TRUE(all.status.ok()) << all.status.message;
+  EXPECT_TRUE(all.Psi == alone(P, C, CF));
+  cage_test::expect_reproduces(all.Psi, C, P, 1e-8);
+
+  const Mesh lion = cage_test::load("pose/lion-reference.ply");
+  EnclosingCageOptions opt;
+  opt.target_vertices = 200;
+  const EnclosingCage cage = enclosing_cage(lion.V, lion.F, opt);
+  ASSERT_TRUE(cage.status.ok()) << cage.status.message;
+  const Eigen::MatrixXd some = lion.V.topRows(64);
+  const MeanValueCoordinates m = mean_value_coordinates(some, cage.V, cage.F);
+  ASSERT_TRUE(m.status.ok()) << m.status.message;
+  EXPECT_TRUE(m.Psi == alone(some, cage.V, cage.F));
+}
+
 TEST(CageContainment, WindingNumbersOfCube) {
   Eigen::MatrixXd C;
   Eigen::MatrixXi CF;
