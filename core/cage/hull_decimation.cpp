@@ -152,11 +152,14 @@ class Decimator {
     while (alive_vertices_ > opt_.target_vertices && !heap_.empty()) {
       // Every collapse leaves the entries of the edges around both ends stale (~10): once they
       // outnumber the live edges (≤ 3 per vertex on a closed surface plus a margin), drop them,
-      // so that pops stop paying for stale entries in a heap several times too deep.
-      if (heap_.size() > 6 * static_cast<size_t>(alive_vertices_) + 64)
+      // so that pops stop paying for stale entries in a heap several times too deep. (At least
+      // twice the size the last compaction left: linear time overall whatever the surface.)
+      if (heap_.size() > std::max(6 * static_cast<size_t>(alive_vertices_) + 64, 2 * compacted_size_)) {
         heap_.compact([&](const HeapEntry& h) {
           return !vert_alive_[h.a] || !vert_alive_[h.b] || h.va != version_[h.a] || h.vb != version_[h.b];
         });
+        compacted_size_ = heap_.size();
+      }
       const HeapEntry e = heap_.pop();
       if (!vert_alive_[e.a] || !vert_alive_[e.b]) continue;
       // The cost depends only on the state of a and b; when either changed, a fresh entry was
@@ -521,6 +524,7 @@ class Decimator {
   std::vector<uint8_t> vert_alive_;
   std::vector<unsigned> version_;  // bumped whenever a vertex moves (heap lazy deletion)
   EdgeHeap heap_;
+  size_t compacted_size_ = 0;  // heap size after the last compaction
   int alive_vertices_ = 0, alive_faces_ = 0, grid_faces_ = 0;
   struct CellEntry {
     int f;
