@@ -94,13 +94,22 @@ EnclosingCage enclosing_cage(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   ho.max_normal_turn_deg = opt.max_normal_turn_deg;
   ho.length_weight = opt.length_weight;
   const double clearance = opt.min_clearance * diag;
-  HullDecimation dec = hull_decimation(offset.V, offset.F, V, clearance, ho, progress.sub(0.35, 0.9));
+  // Decimated in the offset grid's coordinates, where the offset surface is the same bit for bit
+  // for copies of the mesh that differ in their last bits (cage/offset_surface.h): a voxel
+  // surface has exact ties in its collapse costs, and in mesh units such noise broke them
+  // differently (lion-reference: a relative 1e-12 of noise moved the cage by half the diagonal
+  // and the lion-05 transfer by 0.155 of it). The cost and every test of the decimation are
+  // invariant to a translation and a uniform scale.
+  const double h = offset.voxel_size;
+  const Eigen::RowVector3d origin = offset.grid_origin.transpose();
+  const Eigen::MatrixXd P_grid = (V.rowwise() - origin) / h;
+  HullDecimation dec = hull_decimation(offset.V_grid, offset.F, P_grid, clearance / h, ho, progress.sub(0.35, 0.9));
   if (!dec.status.ok()) {
     out.status = dec.status;
     return out;
   }
   out.collapses = dec.collapses;
-  out.V = std::move(dec.V);
+  out.V = (h * dec.V).rowwise() + origin;
   out.F = std::move(dec.F);
 
   CageContainment cc = cage_containment(V, out.V, out.F, 10 * clearance);

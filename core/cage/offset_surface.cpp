@@ -22,9 +22,6 @@ struct Grid {
   double h = 1;
   long size() const { return static_cast<long>(nx) * ny * nz; }
   long index(int i, int j, int k) const { return i + static_cast<long>(nx) * (j + static_cast<long>(ny) * k); }
-  Vec3 position(int i, int j, int k) const {
-    return {origin.x + h * i, origin.y + h * j, origin.z + h * k};
-  }
 };
 
 // 1D squared distance transform of sampled function f (Felzenszwalb & Huttenlocher 2012):
@@ -165,11 +162,13 @@ OffsetSurface offset_surface(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   Grid g;
   g.h = opt.voxel_size > 0 ? opt.voxel_size : longest / opt.resolution;
   const double d = opt.offset_voxels * g.h;
-  const double pad = d + 3 * g.h;  // the offset surface stays two cells away from the border
-  g.origin = Vec3(lo.x() - pad, lo.y() - pad, lo.z() - pad);
-  const long nx = static_cast<long>(std::ceil((hi.x() - lo.x() + 2 * pad) / g.h)) + 1;
-  const long ny = static_cast<long>(std::ceil((hi.y() - lo.y() + 2 * pad) / g.h)) + 1;
-  const long nz = static_cast<long>(std::ceil((hi.z() - lo.z() + 2 * pad) / g.h)) + 1;
+  // The offset surface stays two cells away from the border. Half a voxel more on the low side
+  // keeps the bounding box's planes (and so the extreme vertices) off the grid planes.
+  const double pad = d + 3 * g.h, low_pad = pad + 0.5 * g.h;
+  g.origin = Vec3(lo.x() - low_pad, lo.y() - low_pad, lo.z() - low_pad);
+  const long nx = static_cast<long>(std::ceil((hi.x() - lo.x() + pad + low_pad) / g.h)) + 1;
+  const long ny = static_cast<long>(std::ceil((hi.y() - lo.y() + pad + low_pad) / g.h)) + 1;
+  const long nz = static_cast<long>(std::ceil((hi.z() - lo.z() + pad + low_pad) / g.h)) + 1;
   if (nx * ny * nz > opt.max_grid_nodes) {
     out.status = Status::error(StatusCode::InvalidArgument,
                                "offset grid of " + std::to_string(nx) + "x" + std::to_string(ny) + "x" +
@@ -294,7 +293,7 @@ OffsetSurface offset_surface(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
           for (int t = 0; t < 4; ++t) {
             const int b = corner[t];
             tid[t] = id[b];
-            tp[t] = g.position(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1));
+            tp[t] = Vec3(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1));  // grid coordinates
             if (field[tid[t]] > 0) pos[np++] = t; else neg[nn++] = t;
           }
           if (np == 0 || nn == 0) continue;
@@ -328,11 +327,15 @@ OffsetSurface offset_surface(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
     out.status = Status::error(StatusCode::InvalidMesh, "offset surface is empty (mesh too small for the grid)");
     return out;
   }
+  out.grid_origin = Eigen::Vector3d(g.origin.x, g.origin.y, g.origin.z);
+  out.V_grid.resize(static_cast<long>(verts.size()), 3);
   out.V.resize(static_cast<long>(verts.size()), 3);
   for (size_t v = 0; v < verts.size(); ++v) {
-    out.V(v, 0) = verts[v].x;
-    out.V(v, 1) = verts[v].y;
-    out.V(v, 2) = verts[v].z;
+    const Vec3 p = g.origin + g.h * verts[v];
+    for (int a = 0; a < 3; ++a) {
+      out.V_grid(v, a) = verts[v][a];
+      out.V(v, a) = p[a];
+    }
   }
   out.F.resize(static_cast<long>(tris.size()), 3);
   for (size_t t = 0; t < tris.size(); ++t)

@@ -14,6 +14,13 @@
 // Every point of the input surface lies within ~√3·h of a solid node, so the surface lies at
 // least d − 2·h inside the offset surface (h = voxel size; the interpolation error of the
 // level set is below h). The default d = 3h therefore encloses the input with a margin.
+//
+// Stable under last-bit noise of the input: the grid's origin sits half a voxel off the
+// bounding box's planes (extreme vertices never lie on a grid plane, where floor() would send
+// them to one cell or the next by their last bits), and the surface is also returned in grid
+// coordinates (V_grid), where it depends only on which nodes are solid — the distance transform
+// is exact in voxel units — so copies of a mesh that differ in their last bits give the same
+// V_grid bit for bit. Consumers that must be deterministic (cage/enclosing_cage.h) work there.
 #pragma once
 
 #include <Eigen/Core>
@@ -32,7 +39,9 @@ struct OffsetSurfaceOptions {
 
 struct OffsetSurface {
   Status status;          // InvalidMesh for an empty/non-finite input, InvalidArgument for a bad grid
-  Eigen::MatrixXd V;      // #W by 3 vertices of the offset surface
+  Eigen::MatrixXd V;      // #W by 3 vertices of the offset surface = grid_origin + voxel_size · V_grid
+  Eigen::MatrixXd V_grid; // #W by 3, the same vertices in grid coordinates (node index units)
+  Eigen::Vector3d grid_origin = Eigen::Vector3d::Zero();  // position of grid node (0, 0, 0)
   Eigen::MatrixXi F;      // #T by 3 outward-oriented triangles
   double voxel_size = 0;  // h actually used
   double offset = 0;      // d actually used (mesh units)
