@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <functional>
 #include <limits>
@@ -56,6 +58,13 @@ void cs_for_neighbours(const CsGrid& g, size_t i, Visit&& visit, int k0 = 0, int
   const auto& N = cs_neighbours();
   int x, y, z;
   g.xyz(i, &x, &y, &z);
+  if (x > 0 && y > 0 && z > 0 && x + 1 < g.nx && y + 1 < g.ny && z + 1 < g.nz) {
+    // Away from the border every neighbour is inside: index offsets, no checks.
+    const ptrdiff_t sy = g.nx, sz = ptrdiff_t(g.nx) * g.ny;
+    for (int k = k0; k < k1; ++k)
+      if (!visit(size_t(ptrdiff_t(i) + N.d[k][0] + sy * N.d[k][1] + sz * N.d[k][2]), k)) return;
+    return;
+  }
   for (int k = k0; k < k1; ++k) {
     const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
     if (g.in(a, b, c) && !visit(g.idx(a, b, c), k)) return;
@@ -106,23 +115,36 @@ bool cs_dijkstra(const CsGrid& g, const std::vector<uint8_t>& solid, const CsCut
   return false;
 }
 
-// Breadth-first layers (26-neighbourhood) from every cell with mask == from_value, up to
-// max_layers; returns the layer of each cell (max_layers + 1 beyond).
-std::vector<int> cs_layers_from(const CsGrid& g, const std::vector<uint8_t>& mask, uint8_t from_value, int max_layers) {
-  std::vector<int> layer(g.size(), max_layers + 1);
-  std::deque<size_t> q;
-  for (size_t i = 0; i < g.size(); ++i)
-    if (mask[i] == from_value) layer[i] = 0, q.push_back(i);
-  while (!q.empty()) {
-    const size_t i = q.front();
-    q.pop_front();
-    if (layer[i] >= max_layers) continue;
-    cs_for_neighbours(g, i, [&](size_t j, int) {
-      if (layer[j] > layer[i] + 1) layer[j] = layer[i] + 1, q.push_back(j);
-      return true;
-    });
+// Cells within k steps (26-neighbourhood) of a cell with mask == from_value: 1, else 0. Breadth-
+// first layers of the 26-neighbourhood on an unobstructed box are the Chebyshev distance, so this
+// is the dilation by a (2k+1)³ cube, done as three 1-D passes of a sliding window (one counter per
+// line): linear in the grid, and the same cells as the breadth-first search it replaces (which
+// took 18 % of the joints bench).
+std::vector<uint8_t> cs_dilate(const CsGrid& g, const std::vector<uint8_t>& mask, uint8_t from_value, int k) {
+  std::vector<uint8_t> a(g.size()), b(g.size());
+  for (size_t i = 0; i < g.size(); ++i) a[i] = mask[i] == from_value;
+  if (k <= 0) return a;
+  const int dims[3] = {g.nx, g.ny, g.nz};
+  const size_t stride[3] = {1, size_t(g.nx), size_t(g.nx) * g.ny};
+  for (int axis = 0; axis < 3; ++axis) {
+    const int n = dims[axis];
+    const size_t st = stride[axis];
+    const int o1 = (axis + 1) % 3, o2 = (axis + 2) % 3;
+    for (int v = 0; v < dims[o2]; ++v)
+      for (int u = 0; u < dims[o1]; ++u) {
+        const size_t base = size_t(u) * stride[o1] + size_t(v) * stride[o2];
+        // count = ones in [x − k, x + k] ∩ [0, n).
+        int count = 0;
+        for (int x = 0; x < std::min(k, n); ++x) count += a[base + x * st];
+        for (int x = 0; x < n; ++x) {
+          if (x + k < n) count += a[base + (x + k) * st];
+          if (x - k - 1 >= 0) count -= a[base + (x - k - 1) * st];
+          b[base + x * st] = count > 0;
+        }
+      }
+    a.swap(b);
   }
-  return layer;
+  return a;
 }
 
 // Two-pass chamfer distance (weights 1, √2, √3) from the empty cells, in cells.
@@ -202,10 +224,7 @@ void cs_rasterize(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const std:
 // cells are solid too.
 std::vector<uint8_t> cs_fill_solid(const CsGrid& g, const std::vector<uint8_t>& surf, int close_holes) {
   std::vector<uint8_t> wall = surf;
-  if (close_holes > 0) {
-    const std::vector<int> lay = cs_layers_from(g, surf, 1, close_holes);
-    for (size_t i = 0; i < g.size(); ++i) wall[i] = lay[i] <= close_holes;
-  }
+  if (close_holes > 0) wall = cs_dilate(g, surf, 1, close_holes);
   std::vector<uint8_t> ext(g.size(), 0);
   std::vector<size_t> stack;
   for (size_t i = 0; i < g.size(); ++i) {
@@ -215,11 +234,20 @@ std::vector<uint8_t> cs_fill_solid(const CsGrid& g, const std::vector<uint8_t>& 
       ext[i] = 1, stack.push_back(i);
   }
   const int d6[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  const ptrdiff_t sy = g.nx, sz = ptrdiff_t(g.nx) * g.ny;
+  const ptrdiff_t o6[6] = {1, -1, sy, -sy, sz, -sz};
   while (!stack.empty()) {
     const size_t i = stack.back();
     stack.pop_back();
     int x, y, z;
     g.xyz(i, &x, &y, &z);
+    if (x > 0 && y > 0 && z > 0 && x + 1 < g.nx && y + 1 < g.ny && z + 1 < g.nz) {
+      for (const ptrdiff_t o : o6) {
+        const size_t j = size_t(ptrdiff_t(i) + o);
+        if (!ext[j] && !wall[j]) ext[j] = 1, stack.push_back(j);
+      }
+      continue;
+    }
     for (const auto& d : d6) {
       const int a = x + d[0], b = y + d[1], c = z + d[2];
       if (!g.in(a, b, c)) continue;
@@ -228,9 +256,9 @@ std::vector<uint8_t> cs_fill_solid(const CsGrid& g, const std::vector<uint8_t>& 
     }
   }
   std::vector<uint8_t> solid(g.size(), 0);
-  std::vector<int> lay;
-  if (close_holes > 0) lay = cs_layers_from(g, ext, 1, close_holes);
-  for (size_t i = 0; i < g.size(); ++i) solid[i] = surf[i] || (!ext[i] && (close_holes == 0 || lay[i] > close_holes));
+  std::vector<uint8_t> near_ext;  // the exterior dilated by close_holes: what the closing eroded
+  if (close_holes > 0) near_ext = cs_dilate(g, ext, 1, close_holes);
+  for (size_t i = 0; i < g.size(); ++i) solid[i] = surf[i] || (!ext[i] && (close_holes == 0 || !near_ext[i]));
   return solid;
 }
 
