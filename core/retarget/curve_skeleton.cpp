@@ -227,12 +227,14 @@ std::vector<uint8_t> cs_fill_solid(const CsGrid& g, const std::vector<uint8_t>& 
   if (close_holes > 0) wall = cs_dilate(g, surf, 1, close_holes);
   std::vector<uint8_t> ext(g.size(), 0);
   std::vector<size_t> stack;
-  for (size_t i = 0; i < g.size(); ++i) {
-    int x, y, z;
-    g.xyz(i, &x, &y, &z);
-    if ((x == 0 || y == 0 || z == 0 || x == g.nx - 1 || y == g.ny - 1 || z == g.nz - 1) && !wall[i])
-      ext[i] = 1, stack.push_back(i);
-  }
+  for (int z = 0; z < g.nz; ++z)
+    for (int y = 0; y < g.ny; ++y) {
+      const bool face = z == 0 || y == 0 || z == g.nz - 1 || y == g.ny - 1;
+      for (int x = 0; x < g.nx; x += face || x == g.nx - 1 ? 1 : g.nx - 1) {  // whole row, or its two ends
+        const size_t i = g.idx(x, y, z);
+        if (!wall[i]) ext[i] = 1, stack.push_back(i);
+      }
+    }
   const int d6[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   const ptrdiff_t sy = g.nx, sz = ptrdiff_t(g.nx) * g.ny;
   const ptrdiff_t o6[6] = {1, -1, sy, -sy, sz, -sz};

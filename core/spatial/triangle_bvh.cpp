@@ -85,20 +85,23 @@ void TriangleBvh::build(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
 }
 
 int TriangleBvh::build_node(int first, int count, std::vector<Eigen::Vector3d>& centroids) {
-  Node node;
-  node.lo.setConstant(std::numeric_limits<double>::infinity());
-  node.hi.setConstant(-std::numeric_limits<double>::infinity());
-  for (int i = first; i < first + count; ++i)
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d v = V_.row(F_(order_[i], k)).transpose();
-      node.lo = node.lo.cwiseMin(v);
-      node.hi = node.hi.cwiseMax(v);
-    }
+  // Nodes in pre-order; a leaf's box from its triangles, an inner node's as the union of its
+  // children's (the same box as from all its triangles: min and max are exact), so each triangle
+  // is read once, not once per level.
   const int id = static_cast<int>(nodes_.size());
-  nodes_.push_back(node);
+  nodes_.emplace_back();
   if (count <= spatial_detail::kLeafSize) {
-    nodes_[id].first = first;
-    nodes_[id].count = count;
+    Node& node = nodes_[id];
+    node.lo.setConstant(std::numeric_limits<double>::infinity());
+    node.hi.setConstant(-std::numeric_limits<double>::infinity());
+    for (int i = first; i < first + count; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3d v = V_.row(F_(order_[i], k)).transpose();
+        node.lo = node.lo.cwiseMin(v);
+        node.hi = node.hi.cwiseMax(v);
+      }
+    node.first = first;
+    node.count = count;
     return id;
   }
   Eigen::Vector3d clo = centroids[order_[first]], chi = clo;
@@ -117,8 +120,11 @@ int TriangleBvh::build_node(int first, int count, std::vector<Eigen::Vector3d>& 
                    });
   const int left = build_node(first, mid - first, centroids);
   const int right = build_node(mid, first + count - mid, centroids);
-  nodes_[id].left = left;
-  nodes_[id].right = right;
+  Node& node = nodes_[id];
+  node.left = left;
+  node.right = right;
+  node.lo = nodes_[left].lo.cwiseMin(nodes_[right].lo);
+  node.hi = nodes_[left].hi.cwiseMax(nodes_[right].hi);
   return id;
 }
 
