@@ -132,12 +132,17 @@ ClosestPoint TriangleBvh::closest_point(const Eigen::Vector3d& p, double max_sq_
   ClosestPoint best;
   best.sq_distance = max_sq_distance;
   if (nodes_.empty()) return best;
+  // Each entry keeps its box's squared distance, computed when it was pushed (the same value the
+  // pop would compute again).
   int stack[128];
+  double stack_d[128];
   int top = 0;
+  stack_d[top] = spatial_detail::box_sq_distance(p, nodes_[0].lo, nodes_[0].hi);
   stack[top++] = 0;
   while (top > 0) {
-    const Node& n = nodes_[stack[--top]];
-    if (spatial_detail::box_sq_distance(p, n.lo, n.hi) >= best.sq_distance) continue;
+    --top;
+    if (stack_d[top] >= best.sq_distance) continue;
+    const Node& n = nodes_[stack[top]];
     if (n.count > 0) {
       for (int i = n.first; i < n.first + n.count; ++i) {
         const int f = order_[i];
@@ -157,13 +162,12 @@ ClosestPoint TriangleBvh::closest_point(const Eigen::Vector3d& p, double max_sq_
     // Visit the nearer child first (pushed last).
     const double dl = spatial_detail::box_sq_distance(p, nodes_[n.left].lo, nodes_[n.left].hi);
     const double dr = spatial_detail::box_sq_distance(p, nodes_[n.right].lo, nodes_[n.right].hi);
-    if (dl <= dr) {
-      stack[top++] = n.right;
-      stack[top++] = n.left;
-    } else {
-      stack[top++] = n.left;
-      stack[top++] = n.right;
-    }
+    // A child no nearer than the best so far would be skipped when popped (the best only
+    // shrinks): it is not pushed.
+    const int near = dl <= dr ? n.left : n.right, far = dl <= dr ? n.right : n.left;
+    const double dnear = std::min(dl, dr), dfar = dl <= dr ? dr : dl;
+    if (dfar < best.sq_distance) stack_d[top] = dfar, stack[top++] = far;
+    if (dnear < best.sq_distance) stack_d[top] = dnear, stack[top++] = near;
   }
   return best;
 }
