@@ -2,6 +2,8 @@
 // farthest-point sampling invariants, plane quadrics, and uniform-grid box queries.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -227,6 +229,26 @@ TEST(SpatialGrid, PointGridBoxQueriesMatchBruteForce) {
   EXPECT_FALSE(grid.for_each_in_box(all_lo, all_hi, [&](int) { return ++calls < 5; }));
   EXPECT_EQ(calls, 5);
   EXPECT_TRUE(mm::PointGrid(Eigen::MatrixXd(0, 3)).for_each_in_box(all_lo, all_hi, [](int) { return false; }));
+}
+
+// The nearest point's squared distance equals Eigen's brute-force minimum bit for bit, for
+// queries inside, outside and on the points (a flat set, coarse and fine grids).
+TEST(SpatialGrid, PointGridNearestEqualsBruteForce) {
+  Lcg rng;
+  Eigen::MatrixXd P(1500, 3);
+  for (int i = 0; i < P.rows(); ++i) P.row(i) << rng.next() * 3 - 1, rng.next(), i % 3 ? rng.next() * 0.5 : 0.25;
+  for (int cells : {1, 9, 48}) {
+    const mm::PointGrid grid(P, cells);
+    for (int t = 0; t < 400; ++t) {
+      Eigen::RowVector3d q;
+      if (t % 4 == 0) q = P.row(t % P.rows());
+      else q << rng.next() * 6 - 2.5, rng.next() * 2 - 0.5, rng.next() * 2 - 0.5;
+      const double p[3] = {q[0], q[1], q[2]};
+      EXPECT_EQ(grid.nearest_sq_distance(p), (P.rowwise() - q).rowwise().squaredNorm().minCoeff()) << cells << " " << t;
+    }
+  }
+  const double p[3] = {0, 0, 0};
+  EXPECT_EQ(mm::PointGrid(Eigen::MatrixXd(0, 3)).nearest_sq_distance(p), std::numeric_limits<double>::infinity());
 }
 
 TEST(SpatialGrid, BoxGridReportsEachEntryOnceAndRemovesIt) {

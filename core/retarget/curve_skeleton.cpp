@@ -51,24 +51,30 @@ struct CsGrid {
   size_t size() const { return size_t(nx) * ny * nz; }
 };
 
-// Calls visit(j, k) for each neighbour j of cell i inside g, neighbours k0 ≤ k < k1 in the order
-// of cs_neighbours(); visit returns false to stop.
+// Calls visit(j, k) for each cell j = i + d[k] inside g, k0 ≤ k < k1 (d: unit steps); visit returns
+// false to stop.
 template <class Visit>
-void cs_for_neighbours(const CsGrid& g, size_t i, Visit&& visit, int k0 = 0, int k1 = 26) {
-  const auto& N = cs_neighbours();
+void cs_for_offsets(const CsGrid& g, size_t i, const int (*d)[3], int k0, int k1, Visit&& visit) {
   int x, y, z;
   g.xyz(i, &x, &y, &z);
   if (x > 0 && y > 0 && z > 0 && x + 1 < g.nx && y + 1 < g.ny && z + 1 < g.nz) {
     // Away from the border every neighbour is inside: index offsets, no checks.
     const ptrdiff_t sy = g.nx, sz = ptrdiff_t(g.nx) * g.ny;
     for (int k = k0; k < k1; ++k)
-      if (!visit(size_t(ptrdiff_t(i) + N.d[k][0] + sy * N.d[k][1] + sz * N.d[k][2]), k)) return;
+      if (!visit(size_t(ptrdiff_t(i) + d[k][0] + sy * d[k][1] + sz * d[k][2]), k)) return;
     return;
   }
   for (int k = k0; k < k1; ++k) {
-    const int a = x + N.d[k][0], b = y + N.d[k][1], c = z + N.d[k][2];
+    const int a = x + d[k][0], b = y + d[k][1], c = z + d[k][2];
     if (g.in(a, b, c) && !visit(g.idx(a, b, c), k)) return;
   }
+}
+
+// Calls visit(j, k) for each neighbour j of cell i inside g, neighbours k0 ≤ k < k1 in the order
+// of cs_neighbours(); visit returns false to stop.
+template <class Visit>
+void cs_for_neighbours(const CsGrid& g, size_t i, Visit&& visit, int k0 = 0, int k1 = 26) {
+  cs_for_offsets(g, i, cs_neighbours().d, k0, k1, visit);
 }
 
 // Steps the geodesic and the bands may not take: between cells owned by two parts whose contact
@@ -235,27 +241,14 @@ std::vector<uint8_t> cs_fill_solid(const CsGrid& g, const std::vector<uint8_t>& 
         if (!wall[i]) ext[i] = 1, stack.push_back(i);
       }
     }
-  const int d6[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  const ptrdiff_t sy = g.nx, sz = ptrdiff_t(g.nx) * g.ny;
-  const ptrdiff_t o6[6] = {1, -1, sy, -sy, sz, -sz};
+  static const int d6[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   while (!stack.empty()) {
     const size_t i = stack.back();
     stack.pop_back();
-    int x, y, z;
-    g.xyz(i, &x, &y, &z);
-    if (x > 0 && y > 0 && z > 0 && x + 1 < g.nx && y + 1 < g.ny && z + 1 < g.nz) {
-      for (const ptrdiff_t o : o6) {
-        const size_t j = size_t(ptrdiff_t(i) + o);
-        if (!ext[j] && !wall[j]) ext[j] = 1, stack.push_back(j);
-      }
-      continue;
-    }
-    for (const auto& d : d6) {
-      const int a = x + d[0], b = y + d[1], c = z + d[2];
-      if (!g.in(a, b, c)) continue;
-      const size_t j = g.idx(a, b, c);
+    cs_for_offsets(g, i, d6, 0, 6, [&](size_t j, int) {
       if (!ext[j] && !wall[j]) ext[j] = 1, stack.push_back(j);
-    }
+      return true;
+    });
   }
   std::vector<uint8_t> solid(g.size(), 0);
   std::vector<uint8_t> near_ext;  // the exterior dilated by close_holes: what the closing eroded

@@ -10,6 +10,7 @@
 
 #include "retarget/bone_blend.h"
 #include "spatial/triangle_bvh.h"
+#include "spatial/uniform_grid.h"
 
 namespace mm {
 
@@ -147,66 +148,17 @@ Eigen::MatrixXd jf_solid_samples(const VoxelSolid& v, int target_count) {
 }
 
 // Chamfer distance of two point sets (step 3's facing score): the mean distance from each point of
-// one to the nearest of the other, averaged both ways. The nearest point is found in a uniform
-// grid over the other set (rings of cells around the query's, until no unvisited cell can be
-// nearer); each candidate's squared distance is summed (dx² + dy²) + dz² like Eigen's row
-// squaredNorm, so the minimum and the result are the same bits as the brute force it replaced
-// (~10× slower at 1,200 × 1,200 samples, for each of four turns).
+// one to the nearest of the other, averaged both ways. Nearest points through a PointGrid
+// (spatial/uniform_grid.h), ~2 points per cell: the same bits as a brute-force minimum, ~10×
+// faster at 1,200 × 1,200 samples (for each of four turns).
 double jf_chamfer(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
   auto one_way = [](const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) {
-    const int ny = static_cast<int>(Y.rows());
     if (X.rows() == 0) return 0.0;
-    if (ny == 0) return std::numeric_limits<double>::infinity();
-    const Eigen::RowVector3d lo = Y.colwise().minCoeff(), hi = Y.colwise().maxCoeff();
-    const double extent = std::max((hi - lo).maxCoeff(), 1e-300);
-    const double cell = extent / std::max(1.0, std::cbrt(ny / 2.0));
-    int dims[3];
-    for (int k = 0; k < 3; ++k) dims[k] = std::max(1, std::min(1 << 10, static_cast<int>((hi[k] - lo[k]) / cell) + 1));
-    auto coord = [&](double v, int k) { return std::clamp(static_cast<int>(std::floor((v - lo[k]) / cell)), 0, dims[k] - 1); };
-    const size_t ncells = size_t(dims[0]) * dims[1] * dims[2];
-    std::vector<int> start(ncells + 1, 0), items(ny);
-    std::vector<size_t> cell_of(ny);
-    for (int j = 0; j < ny; ++j) {
-      cell_of[j] = coord(Y(j, 0), 0) + dims[0] * (coord(Y(j, 1), 1) + size_t(dims[1]) * coord(Y(j, 2), 2));
-      ++start[cell_of[j] + 1];
-    }
-    for (size_t c = 0; c < ncells; ++c) start[c + 1] += start[c];
-    {
-      std::vector<int> fill(start.begin(), start.end() - 1);
-      for (int j = 0; j < ny; ++j) items[fill[cell_of[j]]++] = j;
-    }
-    const int max_ring = std::max({dims[0], dims[1], dims[2]});
+    const PointGrid grid(Y, std::max(1, static_cast<int>(std::lround(std::cbrt(Y.rows() / 2.0)))));
     double sum = 0;
     for (int i = 0; i < X.rows(); ++i) {
-      const double x0 = X(i, 0), x1 = X(i, 1), x2 = X(i, 2);
-      const int c0 = coord(x0, 0), c1 = coord(x1, 1), c2 = coord(x2, 2);
-      double best = std::numeric_limits<double>::infinity();
-      for (int r = 0; r <= max_ring; ++r) {
-        // Rings 0..r−1 are done; a point in ring r or beyond is at least r − 1 cells away.
-        const double gap = (r - 1 - 1e-3) * cell;
-        if (gap > 0 && gap * gap >= best) break;
-        for (int dz = -r; dz <= r; ++dz) {
-          const int z = c2 + dz;
-          if (z < 0 || z >= dims[2]) continue;
-          for (int dy = -r; dy <= r; ++dy) {
-            const int y = c1 + dy;
-            if (y < 0 || y >= dims[1]) continue;
-            const bool shell = std::abs(dz) == r || std::abs(dy) == r;
-            for (int dx = -r; dx <= r; dx += shell || r == 0 ? 1 : 2 * r) {
-              const int x = c0 + dx;
-              if (x < 0 || x >= dims[0]) continue;
-              const size_t c = x + dims[0] * (y + size_t(dims[1]) * z);
-              for (int e = start[c]; e < start[c + 1]; ++e) {
-                const int j = items[e];
-                const double d0 = Y(j, 0) - x0, d1 = Y(j, 1) - x1, d2 = Y(j, 2) - x2;
-                const double d = d0 * d0 + d1 * d1 + d2 * d2;
-                if (d < best) best = d;
-              }
-            }
-          }
-        }
-      }
-      sum += std::sqrt(best);
+      const double p[3] = {X(i, 0), X(i, 1), X(i, 2)};
+      sum += std::sqrt(grid.nearest_sq_distance(p));
     }
     return sum / static_cast<double>(X.rows());
   };

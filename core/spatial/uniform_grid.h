@@ -2,7 +2,7 @@
 // natively and in wasm; cage/hull_decimation takes discrete decisions on them):
 //   UniformGrid  the cell geometry: origin, cell size, cells per axis; coordinates clamp to
 //                the border cells, so every box maps to a (possibly clamped) range of cells.
-//   PointGrid    a fixed point set bucketed once (CSR layout).
+//   PointGrid    a fixed point set bucketed once (CSR layout): box queries, nearest point.
 //   BoxGrid      items inserted by bounding box (each overlapped cell lists the item); items
 //                that change are inserted again and the old entries pruned lazily.
 // Box arguments are any 3-vector type with operator[] (double[3], Eigen::Vector3d, ...).
@@ -77,6 +77,12 @@ class PointGrid {
       return true;
     });
   }
+
+  // Smallest squared distance from p to a row of P (+inf for an empty grid), each candidate's
+  // summed (dx² + dy²) + dz², as Eigen's row squaredNorm does: the same bits as a brute-force
+  // minimum. Searches rings of cells around p's (clamped) cell until no unvisited cell can be
+  // nearer.
+  double nearest_sq_distance(const double p[3]) const;
 
   const UniformGrid& grid() const { return grid_; }
 
