@@ -66,6 +66,49 @@ std::vector<int> sn_elimination_tree(const SnSparse& U) {
   return parent;
 }
 
+// Off-diagonal column counts of the Cholesky factor of a matrix whose lower triangle is C (CSC,
+// rows ≥ the column), numbered so that the identity is a postorder of its elimination tree
+// `parent`: Gilbert, Ng & Peyton's skeleton-leaf method (as in Davis, "Direct methods for sparse
+// linear systems", Sec. 4.5), O(nnz(C) α(n)) instead of the O(nnz(L)) row-subtree walk; the same
+// counts. Each column j starts at 1 if it is a leaf of the tree; every row i whose subtree j is a
+// new leaf of adds 1 at j and, when j is not i's first leaf, removes 1 at the least common
+// ancestor of j and i's previous leaf; the counts are then summed up the tree.
+std::vector<int> sn_column_counts(const SnSparse& C, const std::vector<int>& parent) {
+  const int n = static_cast<int>(C.cols());
+  std::vector<int> delta(n, 0), first(n, -1), maxfirst(n, -1), prevleaf(n, -1), ancestor(n);
+  for (int k = 0; k < n; ++k) {
+    delta[k] = first[k] == -1 ? 1 : 0;  // k is a leaf: no descendant set first[k]
+    for (int j = k; j != -1 && first[j] == -1; j = parent[j]) first[j] = k;
+  }
+  for (int i = 0; i < n; ++i) ancestor[i] = i;
+  for (int j = 0; j < n; ++j) {
+    if (parent[j] != -1) --delta[parent[j]];
+    for (SnSparse::InnerIterator it(C, j); it; ++it) {
+      const int i = static_cast<int>(it.row());
+      // Is j a leaf of row i's subtree (entry (i, j) of L in the tree's skeleton)?
+      if (i <= j || first[j] <= maxfirst[i]) continue;
+      maxfirst[i] = first[j];
+      const int jprev = prevleaf[i];
+      prevleaf[i] = j;
+      ++delta[j];
+      if (jprev == -1) continue;  // i's first leaf
+      int q = jprev;
+      while (q != ancestor[q]) q = ancestor[q];
+      for (int s = jprev; s != q;) {  // path compression
+        const int up = ancestor[s];
+        ancestor[s] = q;
+        s = up;
+      }
+      --delta[q];  // the paths from j and jprev to i overlap above their common ancestor q
+    }
+    if (parent[j] != -1) ancestor[j] = parent[j];
+  }
+  for (int j = 0; j < n; ++j)
+    if (parent[j] != -1) delta[parent[j]] += delta[j];
+  for (int j = 0; j < n; ++j) --delta[j];  // off-diagonal
+  return delta;
+}
+
 // Postorder of a forest: order[k] = the node visited k-th (children in increasing order).
 std::vector<int> sn_postorder(const std::vector<int>& parent) {
   const int n = static_cast<int>(parent.size());
@@ -165,7 +208,8 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
   rows_ptr_.assign(1, 0);
   rows_.clear();
   value_ptr_.assign(1, 0);
-  values_.clear();
+  values_.reset();
+  values_size_ = 0;
   top_.clear();
   first_.clear();
   bins_[0].clear();
@@ -184,28 +228,25 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P = Pinv.inverse();
     for (int i = 0; i < n; ++i) perm_[i] = P.indices()[i];
   }
+  // The elimination tree of the postordered matrix is the AMD-ordered one's, relabelled (a
+  // postorder is a topological order of the tree: it keeps every ancestor after its descendants).
+  std::vector<int> parent(n);
   {
-    const std::vector<int> order = sn_postorder(sn_elimination_tree(sn_permuted_triangle(A, perm_, true)));
+    const std::vector<int> parent0 = sn_elimination_tree(sn_permuted_triangle(A, perm_, true));
+    const std::vector<int> order = sn_postorder(parent0);
     std::vector<int> q(n);
     for (int k = 0; k < n; ++k) q[order[k]] = k;
     for (int i = 0; i < n; ++i) perm_[i] = q[perm_[i]];
+    for (int j = 0; j < n; ++j) parent[q[j]] = parent0[j] < 0 ? -1 : q[parent0[j]];
   }
   const SnSparse C = sn_permuted_triangle(A, perm_, false);
-  const SnSparse U = sn_permuted_triangle(A, perm_, true);
-  const std::vector<int> parent = sn_elimination_tree(U);
   if (!progress.update("factor: analysis", 0.5)) return cancelled_status("factor");
 
-  // ---- column counts of L (off-diagonal) by row subtrees: O(nnz(L)).
-  std::vector<int> cc(n, 0), mark(n, -1), nchild(n, 0);
-  for (int k = 0; k < n; ++k) {
-    mark[k] = k;
-    for (SnSparse::InnerIterator it(U, k); it; ++it)
-      for (int j = static_cast<int>(it.row()); j < k && mark[j] != k; j = parent[j]) {
-        ++cc[j];
-        mark[j] = k;
-      }
+  // ---- column counts of L (off-diagonal) on the postordered tree (the identity is its postorder).
+  const std::vector<int> cc = sn_column_counts(C, parent);
+  std::vector<int> mark(n, -1), nchild(n, 0);
+  for (int k = 0; k < n; ++k)
     if (parent[k] != -1) ++nchild[parent[k]];
-  }
 
   // ---- fundamental supernodes, then relaxed amalgamation of a child into the next supernode.
   std::vector<int> fundamental = {0};
@@ -274,7 +315,8 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     value_ptr_.push_back(value_ptr_.back() + m * ncols);
     total_flops += static_cast<double>(ncols) * m * m;
   }
-  values_.assign(static_cast<size_t>(value_ptr_.back()), 0.0);
+  values_size_ = value_ptr_.back();
+  values_.reset(new double[static_cast<size_t>(values_size_)]);
   if (!progress.update("factor: analysis", 1.0)) return cancelled_status("factor");
 
   // ---- numeric multifrontal factorization in sn_postorder. Each supernode's update matrix waits
@@ -338,8 +380,11 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
       Eigen::Map<Eigen::MatrixXd> Us(updates[s].get(), nr, nr);
       for (int b = 0; b < nr; ++b) Us.col(b).tail(nr - b) = F22.col(b).tail(nr - b);
     }
-    Eigen::Map<Eigen::MatrixXd> Ls(values_.data() + value_ptr_[s], m, ncols);
-    for (int k = 0; k < ncols; ++k) Ls.col(k).tail(m - k) = Fm.col(k).tail(m - k);
+    Eigen::Map<Eigen::MatrixXd> Ls(values_.get() + value_ptr_[s], m, ncols);
+    for (int k = 0; k < ncols; ++k) {
+      Ls.col(k).head(k).setZero();  // the diagonal block's strict upper triangle
+      Ls.col(k).tail(m - k) = Fm.col(k).tail(m - k);
+    }
     for (int k = 0; k < ncols; ++k) {
       const double d = values_[value_ptr_[s] + static_cast<long>(k) * m + k];
       if (!(d > 0) || !std::isfinite(d))
@@ -622,7 +667,7 @@ void sn_diagonal_transpose_solve(const double* D, long ld, int ncols, double* y)
 
 void SupernodalCholesky::forward_supernode(int s, RowMatrix& Y, RowMatrix& tmp, int limit, SolveLog* log) const {
   const int f = start_[s], ncols = start_[s + 1] - f, nr = rows_ptr_[s + 1] - rows_ptr_[s], m = ncols + nr;
-  const Eigen::Map<const Eigen::MatrixXd> L(values_.data() + value_ptr_[s], m, ncols);
+  const Eigen::Map<const Eigen::MatrixXd> L(values_.get() + value_ptr_[s], m, ncols);
   auto Ys = Y.middleRows(f, ncols);
   // A few right-hand sides (drags, refinement, the handle basis): the loops above, with the row
   // length known at compile time; Eigen's triangular solve and GEMM pack their operands first,
@@ -655,7 +700,7 @@ void SupernodalCholesky::forward_supernode(int s, RowMatrix& Y, RowMatrix& tmp, 
 
 void SupernodalCholesky::backward_supernode(int s, RowMatrix& Y, RowMatrix& tmp) const {
   const int f = start_[s], ncols = start_[s + 1] - f, nr = rows_ptr_[s + 1] - rows_ptr_[s], m = ncols + nr;
-  const Eigen::Map<const Eigen::MatrixXd> L(values_.data() + value_ptr_[s], m, ncols);
+  const Eigen::Map<const Eigen::MatrixXd> L(values_.get() + value_ptr_[s], m, ncols);
   auto Ys = Y.middleRows(f, ncols);
   const bool skinny = Y.cols() <= kSkinny;  // as in forward_supernode
   if (nr > 0) {

@@ -13,6 +13,7 @@
 // singular); Cancelled when the progress sink asks to stop (checked between supernodes).
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
@@ -37,7 +38,7 @@ class SupernodalCholesky {
 
   bool factored() const { return factored_; }
   int size() const { return n_; }
-  long factor_entries() const { return static_cast<long>(values_.size()); }  // stored (dense) entries of L
+  long factor_entries() const { return values_size_; }  // stored (dense) entries of L
   int supernodes() const { return static_cast<int>(start_.size()) - 1; }
 
   // X = A⁻¹ B for B n by k. NumericalError if the result is not finite. A factor computed on two
@@ -54,7 +55,10 @@ class SupernodalCholesky {
   std::vector<int> rows_ptr_;      // rows below the diagonal block of s: rows_[rows_ptr_[s] .. rows_ptr_[s+1])
   std::vector<int> rows_;
   std::vector<long> value_ptr_;    // dense block of s: (ncols + nrows) by ncols, column-major
-  std::vector<double> values_;
+  // Not zero-filled when allocated (the factorization writes every entry: 111 MB at 50k vertices,
+  // whose zeroing the kernel does anyway on first touch).
+  std::unique_ptr<double[]> values_;
+  long values_size_ = 0;
   // The factor's two-thread split, kept for the solves (empty when it factored on one thread):
   // supernodes above the cut, and per thread the subtrees (root s covers supernodes first_[s]..s).
   std::vector<char> top_;
@@ -71,5 +75,18 @@ class SupernodalCholesky {
   void forward_supernode(int s, RowMatrix& Y, RowMatrix& tmp, int limit, SolveLog* log) const;
   void backward_supernode(int s, RowMatrix& Y, RowMatrix& tmp) const;
 };
+
+// The symbolic steps, exposed for tests (tests/linalg_test.cpp).
+namespace supernodal_detail {
+// Lower (or upper) triangle of P A Pᵀ from A's lower triangle; row i of A becomes p[i].
+Eigen::SparseMatrix<double> sn_permuted_triangle(const Eigen::SparseMatrix<double>& A, const std::vector<int>& p, bool upper);
+// Elimination tree from the upper triangle (parent −1 at roots).
+std::vector<int> sn_elimination_tree(const Eigen::SparseMatrix<double>& U);
+// order[k] = the node visited k-th by a postorder of the forest.
+std::vector<int> sn_postorder(const std::vector<int>& parent);
+// Off-diagonal column counts of L from the lower triangle C of a matrix numbered in a postorder of
+// its elimination tree `parent`.
+std::vector<int> sn_column_counts(const Eigen::SparseMatrix<double>& C, const std::vector<int>& parent);
+}  // namespace supernodal_detail
 
 }  // namespace mm
