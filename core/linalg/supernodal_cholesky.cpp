@@ -329,6 +329,7 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     std::vector<double> front;
     std::vector<double> pack;  // wasm rank update's row panels
     std::vector<int> rel;      // a child's rows in the front
+    std::vector<int> run;      // lengths of their runs of consecutive front rows
   };
   auto factor_supernode = [&](int s, Scratch& w) -> Status {
     const int f = start_[s], l = start_[s + 1], ncols = l - f;
@@ -351,12 +352,24 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
       const int* CR = rows_.data() + rows_ptr_[child];
       const double* Uc = updates[child].get();
       w.rel.resize(cn);
+      w.run.resize(cn);
       for (int a = 0; a < cn; ++a) w.rel[a] = w.relpos[CR[a]];
+      // run[a]: how many of the child's rows from a on land on consecutive rows of the front (the
+      // usual case: a child's rows are mostly its parent's, in order), so that the scatter is a
+      // plain vector add along each run. The same additions in the same order as one at a time.
       const int* rel = w.rel.data();
+      int* run = w.run.data();
+      for (int a = cn - 1; a >= 0; --a) run[a] = a + 1 < cn && rel[a + 1] == rel[a] + 1 ? run[a + 1] + 1 : 1;
       for (int b = 0; b < cn; ++b) {
         double* col = w.front.data() + static_cast<size_t>(rel[b]) * m;
         const double* u = Uc + static_cast<size_t>(b) * cn;
-        for (int a = b; a < cn; ++a) col[rel[a]] += u[a];
+        for (int a = b; a < cn;) {
+          double* dst = col + rel[a];
+          const double* src = u + a;
+          const int len = run[a];
+          for (int k = 0; k < len; ++k) dst[k] += src[k];
+          a += len;
+        }
       }
       updates[child].reset();
     }
@@ -397,7 +410,7 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     return ncols * m * m;
   };
   double done_flops = 0, reported = 0;
-  Scratch main_scratch{std::vector<int>(n, -1), {}, {}, {}};
+  Scratch main_scratch{std::vector<int>(n, -1), {}, {}, {}, {}};
   // Supernodes the calling thread factors in order (all of them, or the top of the tree once the
   // subtrees below are done).
   std::vector<int> sequence;
@@ -458,7 +471,7 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
         }
       }
     };
-    Scratch worker_scratch{std::vector<int>(n, -1), {}, {}, {}};
+    Scratch worker_scratch{std::vector<int>(n, -1), {}, {}, {}, {}};
     Status main_status = Status::success();
     Task worker([&] { run(bins[1], worker_scratch, &worker_status); });
     run(bins[0], main_scratch, &main_status);
