@@ -221,10 +221,34 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
 
   // ---- ordering: AMD, then a sn_postorder of the elimination tree (same fill, contiguous subtrees).
   {
-    Eigen::AMDOrdering<int> amd;
+    // AMD's input: A's full symmetric pattern with its diagonal, entries in the order Eigen's
+    // self-adjoint AMD overload writes them (so the same ordering), as a pattern only (one byte
+    // of "value" per entry instead of a copy of A's doubles) and with the elbow room AMD works
+    // in reserved up front (it would reallocate and copy the pattern).
+    std::vector<int> count(n + 1, 0);
+    for (int j = 0; j < n; ++j)
+      for (SnSparse::InnerIterator it(A, j); it; ++it) {
+        const int i = static_cast<int>(it.row());
+        if (i < j) continue;  // only the lower triangle is read
+        ++count[j + 1];
+        if (i != j) ++count[i + 1];
+      }
+    for (int j = 0; j < n; ++j) count[j + 1] += count[j];
+    const long nnz = count[n];
+    Eigen::SparseMatrix<char, Eigen::ColMajor, int> S(n, n);
+    S.reserve(nnz + nnz / 5 + 2 * static_cast<long>(n));
+    S.resizeNonZeros(nnz);
+    std::copy(count.begin(), count.end(), S.outerIndexPtr());
+    int* Si = S.innerIndexPtr();
+    for (int j = 0; j < n; ++j)
+      for (SnSparse::InnerIterator it(A, j); it; ++it) {
+        const int i = static_cast<int>(it.row());
+        if (i < j) continue;
+        Si[count[j]++] = i;
+        if (i != j) Si[count[i]++] = j;
+      }
     Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> Pinv;
-    // The self-adjoint overload symmetrises once (the plain one would form A + Aᵀ again).
-    amd(A.selfadjointView<Eigen::Lower>(), Pinv);
+    Eigen::internal::minimum_degree_ordering(S, Pinv);
     const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P = Pinv.inverse();
     for (int i = 0; i < n; ++i) perm_[i] = P.indices()[i];
   }
