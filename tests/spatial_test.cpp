@@ -2,16 +2,20 @@
 // farthest-point sampling invariants, plane quadrics, and uniform-grid box queries.
 #include <gtest/gtest.h>
 
+#include <iostream>
 #include <limits>
+#include <string>
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
+#include "io/asset.h"
 #include "spatial/farthest_point_sampling.h"
 #include "spatial/quadric.h"
 #include "spatial/triangle_bvh.h"
 #include "spatial/uniform_grid.h"
+#include "test_support.h"
 
 namespace {
 
@@ -113,6 +117,76 @@ TEST(SpatialBvh, InsideAndWinding) {
   EXPECT_FALSE(two.inside({1.25, 0.25, 0.25}));
 }
 
+// inside() casts its 7 rays through a projected grid per direction (triangle_bvh.cpp): it must
+// answer as the majority of the tree's own ray_winding along the same directions, on real meshes
+// (interpenetrating parts, open surfaces, an axis-aligned cube) and at the hardest points: the
+// vertices themselves (rays through edges and corners), points just off the surface, points far
+// outside and random points around the mesh.
+TEST(SpatialBvh, InsideGridsAnswerAsTheRayTraversal) {
+  const auto majority = [](const mm::TriangleBvh& bvh, const Eigen::Vector3d& p) {
+    int votes = 0;
+    for (int r = 0; r < 7; ++r) votes += std::abs(bvh.ray_winding(p, mm::TriangleBvh::inside_direction(r))) >= 1;
+    return votes >= 4;
+  };
+  struct Mesh {
+    std::string name;
+    Eigen::MatrixXd V;
+    Eigen::MatrixXi F;
+  };
+  std::vector<Mesh> meshes;
+  for (const char* rel : {"anim/KayKit/Knight.glb", "anim/RobotExpressive/RobotExpressive.glb", "anim/human_woman.ply",
+                          "edit/camelhead.ply", "edit/hand_lowres.ply"}) {
+    const mm::io::LoadResult r = mm::io::load_asset(mm::test::data_path(rel));
+    ASSERT_TRUE(r.status.ok()) << rel << ": " << r.status.message;
+    meshes.push_back({rel, r.asset.V_raw, r.asset.F_raw});
+  }
+  meshes.push_back({"cube", {}, {}});
+  unit_cube(&meshes.back().V, &meshes.back().F);
+  Lcg rng;
+  for (const Mesh& m : meshes) {
+    const mm::TriangleBvh built(m.V, m.F);
+    const mm::TriangleBvh bvh = built;  // a copy shares (or builds) the same grids
+    const Eigen::Vector3d lo = m.V.colwise().minCoeff(), hi = m.V.colwise().maxCoeff();
+    const double diag = (hi - lo).norm();
+    std::vector<Eigen::Vector3d> pts;
+    for (int v = 0; v < m.V.rows(); v += std::max<int>(1, int(m.V.rows()) / 1500)) pts.push_back(m.V.row(v).transpose());
+    for (int f = 0; f < m.F.rows(); f += std::max<int>(1, int(m.F.rows()) / 1500)) {
+      const Eigen::Vector3d a = m.V.row(m.F(f, 0)), b = m.V.row(m.F(f, 1)), c = m.V.row(m.F(f, 2));
+      const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
+      if (!n.allFinite()) continue;
+      for (double off : {-1e-3, -1e-9, 0.0, 1e-9, 1e-3}) pts.push_back((a + b + c) / 3 + off * diag * n);
+      pts.push_back(0.5 * (a + b));  // on an edge
+    }
+    for (int k = 0; k < 3000; ++k) {
+      Eigen::Vector3d x;
+      for (int d = 0; d < 3; ++d) x[d] = lo[d] - 0.2 * diag + (hi[d] - lo[d] + 0.4 * diag) * rng.next();
+      pts.push_back(x);
+    }
+    pts.push_back(lo - 10 * diag * Eigen::Vector3d::Ones());
+    pts.push_back(hi + 1e3 * diag * Eigen::Vector3d(1, -2, 3));
+    // The grids are built after max(1024, #F) queries on the tree: ask until they are, then once more.
+    int n_inside = 0, mismatches = 0;
+    for (int pass = 0; pass < 100; ++pass) {
+      const bool ready = bvh.inside_grids_ready();
+      n_inside = 0;
+      for (const Eigen::Vector3d& p : pts) {
+        const bool g = bvh.inside(p);
+        n_inside += g;
+        if (g != majority(built, p) && ++mismatches <= 5)
+          ADD_FAILURE() << m.name << ": inside() " << g << " at " << p.transpose() << ", the rays say otherwise";
+      }
+      if (ready) break;
+    }
+    EXPECT_TRUE(bvh.inside_grids_ready()) << m.name;
+    EXPECT_EQ(mismatches, 0) << m.name;
+    EXPECT_GT(n_inside, 0) << m.name;
+    EXPECT_LT(n_inside, int(pts.size())) << m.name;
+    std::cout << "[ " << m.name << " ] " << pts.size() << " points, " << n_inside << " inside\n";
+  }
+  EXPECT_FALSE(mm::TriangleBvh().inside({0, 0, 0}));
+  EXPECT_FALSE(mm::TriangleBvh(meshes.back().V, meshes.back().F).inside({std::nan(""), 0.5, 0.5}));
+}
+
 TEST(SpatialBvh, SegmentHits) {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
@@ -150,6 +224,79 @@ TEST(SpatialSampling, FarthestPointSamplingSpreadsAndIsDeterministic) {
   // On a unit sphere, 40 well-spread points are ~0.5 apart (area 4π / 40 per point).
   EXPECT_GT(r1, 0.3);
   EXPECT_EQ(mm::farthest_point_sampling(V, 1000, 0).size(), size_t(V.rows()));
+}
+
+// The plain O(n·count) farthest-point sampling that the blocked one (spatial/
+// farthest_point_sampling.cpp) must reproduce pick for pick.
+std::vector<int> fps_reference(const Eigen::MatrixXd& P, int count, int first, double* min_distance) {
+  const int n = int(P.rows());
+  std::vector<int> chosen;
+  if (n == 0 || count <= 0) return chosen;
+  count = std::min(count, n);
+  Eigen::VectorXd d2 = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
+  int next = std::clamp(first, 0, n - 1);
+  double last = 0;
+  for (int k = 0; k < count; ++k) {
+    chosen.push_back(next);
+    last = std::sqrt(d2[next]);
+    d2[next] = -1;
+    for (int i = 0; i < n; ++i) {
+      const double dx = P(i, 0) - P(next, 0), dy = P(i, 1) - P(next, 1), dz = P(i, 2) - P(next, 2);
+      const double d = (dx * dx + dy * dy) + dz * dz;
+      d2[i] = d < d2[i] ? d : d2[i];
+    }
+    int best = -1;
+    double threshold = -0.5;
+    for (int i = 0; i < n; ++i)
+      if (d2[i] > threshold) best = i, threshold = d2[i] * (1 + 1e-9) + 1e-300;
+    if (best < 0) break;
+    next = best;
+  }
+  *min_distance = chosen.size() > 1 ? last : 0.0;
+  return chosen;
+}
+
+// The blocked sampling skips blocks whose distances cannot change or win: the picks and the
+// sampling radius must be the plain loop's exactly, on surface samples of real meshes (blocks
+// compact), the same points shuffled (blocks spread over the whole mesh), a regular grid (exact
+// ties everywhere) and points with duplicates.
+TEST(SpatialSampling, BlockedFarthestPointsEqualThePlainLoop) {
+  std::vector<std::pair<std::string, Eigen::MatrixXd>> sets;
+  for (const char* rel : {"anim/human_woman.ply", "anim/KayKit/Knight.glb", "edit/camelhead.ply"}) {
+    const mm::io::LoadResult r = mm::io::load_asset(mm::test::data_path(rel));
+    ASSERT_TRUE(r.status.ok()) << rel;
+    const Eigen::MatrixXd S = mm::surface_samples(r.asset.V_raw, r.asset.F_raw, 2000).P;
+    sets.push_back({rel, S.topRows(std::min<Eigen::Index>(S.rows(), 3000))});  // the plain loop is quadratic
+  }
+  {
+    Eigen::MatrixXd S = sets[0].second;
+    std::vector<int> perm(S.rows());
+    for (int i = 0; i < int(perm.size()); ++i) perm[i] = i;
+    Lcg rng;
+    for (int i = int(perm.size()) - 1; i > 0; --i) std::swap(perm[i], perm[int(rng.next() * (i + 1))]);
+    Eigen::MatrixXd T(S.rows(), 3);
+    for (int i = 0; i < int(perm.size()); ++i) T.row(i) = S.row(perm[i]);
+    sets.push_back({"shuffled woman", T});
+  }
+  {
+    Eigen::MatrixXd G(30 * 30 * 4, 3);
+    int k = 0;
+    for (int x = 0; x < 30; ++x)
+      for (int y = 0; y < 30; ++y)
+        for (int z = 0; z < 4; ++z) G.row(k++) << x * 0.1, y * 0.1, z * 0.1;
+    sets.push_back({"grid", G});
+    Eigen::MatrixXd D(2 * G.rows(), 3);
+    D << G, G;
+    sets.push_back({"grid twice", D});
+  }
+  for (const auto& [name, P] : sets)
+    for (const auto& [count, first] : {std::pair<int, int>{200, 0}, {int(P.rows()), 7}, {int(P.rows()) / 2, int(P.rows()) - 1}}) {
+      double ra = -1, rb = -1;
+      const std::vector<int> a = mm::farthest_point_sampling(P, count, first, &ra);
+      const std::vector<int> b = fps_reference(P, count, first, &rb);
+      EXPECT_EQ(a, b) << name << ", " << count << " of " << P.rows() << " from " << first;
+      EXPECT_EQ(ra, rb) << name;
+    }
 }
 
 TEST(SpatialSampling, SurfaceSamplesCoverFacesUniformly) {

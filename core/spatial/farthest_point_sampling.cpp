@@ -14,27 +14,56 @@ std::vector<int> farthest_point_sampling(const Eigen::MatrixXd& P, int count, in
   count = std::min(count, n);
   first = std::clamp(first, 0, n - 1);
   chosen.reserve(count);
-  // Squared distance of each point to the chosen set; updated incrementally, O(n·count).
+  // Squared distance of each point to the chosen set; updated incrementally.
   Eigen::VectorXd d2 = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
+  const double* px = P.col(0).data();
+  const double* py = P.col(1).data();
+  const double* pz = P.col(2).data();
+  double* dd = d2.data();
+  // Points in blocks of consecutive indices, each with its bounding box and the largest of its
+  // distances. A block the new point cannot come nearer to than that largest distance (its box
+  // is farther, with a relative 1e-12 to spare for rounding) keeps every distance: its update is
+  // skipped. The scan for the farthest point skips a block whose largest distance cannot beat
+  // the scan's threshold. Both skip only work whose outcome is known, so the picks are the ones
+  // of the plain O(n·count) loop, bit for bit; surface samples come in vertex and face order,
+  // which keeps blocks compact, and late picks touch only the blocks near them.
+  constexpr int kBlock = 64;
+  const int nb = (n + kBlock - 1) / kBlock;
+  std::vector<double> box(6 * static_cast<size_t>(nb));
+  std::vector<double> block_max(nb, std::numeric_limits<double>::infinity());
+  for (int b = 0; b < nb; ++b) {
+    double* q = &box[6 * static_cast<size_t>(b)];
+    const int i0 = b * kBlock, i1 = std::min(n, i0 + kBlock);
+    q[0] = q[3] = px[i0], q[1] = q[4] = py[i0], q[2] = q[5] = pz[i0];
+    for (int i = i0 + 1; i < i1; ++i) {
+      q[0] = std::min(q[0], px[i]), q[1] = std::min(q[1], py[i]), q[2] = std::min(q[2], pz[i]);
+      q[3] = std::max(q[3], px[i]), q[4] = std::max(q[4], py[i]), q[5] = std::max(q[5], pz[i]);
+    }
+  }
   int next = first;
   double last = 0;
   for (int k = 0; k < count; ++k) {
     chosen.push_back(next);
     last = std::sqrt(d2[next]);
     d2[next] = -1;  // chosen points never come back
-    const double qx = P(next, 0), qy = P(next, 1), qz = P(next, 2);
-    // Two passes. The distances: branch-free, so the compiler vectorises them (the same
-    // expression per point, so native and wasm round alike); a chosen point keeps its −1 (every
-    // distance is ≥ 0). Then the farthest point, a scan that rarely takes its branch. This was one
-    // loop with both branches; the retargeter's precompute spent a third of its native time in it.
-    const double* px = P.col(0).data();
-    const double* py = P.col(1).data();
-    const double* pz = P.col(2).data();
-    double* dd = d2.data();
-    for (int i = 0; i < n; ++i) {
-      const double dx = px[i] - qx, dy = py[i] - qy, dz = pz[i] - qz;
-      const double d = (dx * dx + dy * dy) + dz * dz;
-      dd[i] = d < dd[i] ? d : dd[i];
+    block_max[next / kBlock] = std::numeric_limits<double>::infinity();  // recomputed below
+    const double qx = px[next], qy = py[next], qz = pz[next];
+    for (int b = 0; b < nb; ++b) {
+      const double* q = &box[6 * static_cast<size_t>(b)];
+      const double ex = std::max({q[0] - qx, qx - q[3], 0.0}), ey = std::max({q[1] - qy, qy - q[4], 0.0}),
+                   ez = std::max({q[2] - qz, qz - q[5], 0.0});
+      if ((ex * ex + ey * ey) + ez * ez > block_max[b] * (1 + 1e-12)) continue;
+      // The distances: branch-free, so the compiler vectorises them (the same expression per
+      // point, so native and wasm round alike); a chosen point keeps its −1 (every distance is ≥ 0).
+      const int i0 = b * kBlock, i1 = std::min(n, i0 + kBlock);
+      double m = -1;
+      for (int i = i0; i < i1; ++i) {
+        const double dx = px[i] - qx, dy = py[i] - qy, dz = pz[i] - qz;
+        const double d = (dx * dx + dy * dy) + dz * dz;
+        dd[i] = d < dd[i] ? d : dd[i];
+        m = dd[i] > m ? dd[i] : m;
+      }
+      block_max[b] = m;
     }
     // Near-ties (regular samplings have many exact ties in exact arithmetic) go to the lower
     // index: a point must be farther by a relative 1e-9 to win, so last-bit differences of the
@@ -42,11 +71,15 @@ std::vector<int> farthest_point_sampling(const Eigen::MatrixXd& P, int count, in
     // threshold lets any distance (≥ 0) win and no chosen point (−1); later ones are ≥ 1e-300.
     int best = -1;
     double threshold = -0.5;
-    for (int i = 0; i < n; ++i)
-      if (dd[i] > threshold) {
-        best = i;
-        threshold = dd[i] * (1 + 1e-9) + 1e-300;
-      }
+    for (int b = 0; b < nb; ++b) {
+      if (!(block_max[b] > threshold)) continue;
+      const int i0 = b * kBlock, i1 = std::min(n, i0 + kBlock);
+      for (int i = i0; i < i1; ++i)
+        if (dd[i] > threshold) {
+          best = i;
+          threshold = dd[i] * (1 + 1e-9) + 1e-300;
+        }
+    }
     if (best < 0) break;
     next = best;
   }

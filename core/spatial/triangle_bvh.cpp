@@ -73,6 +73,7 @@ void TriangleBvh::build(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   V_ = V;
   F_ = F;
   nodes_.clear();
+  inside_grids_ = std::make_shared<LazyInsideGrids>();
   order_.resize(F.rows());
   if (F.rows() == 0) return;
   std::vector<Eigen::Vector3d> centroids(F.rows());
@@ -82,6 +83,10 @@ void TriangleBvh::build(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   }
   nodes_.reserve(2 * F.rows() / spatial_detail::kLeafSize + 2);
   build_node(0, static_cast<int>(F.rows()), centroids);
+  corners_.resize(9 * static_cast<size_t>(F.rows()));
+  for (Eigen::Index i = 0; i < F.rows(); ++i)
+    for (int k = 0; k < 3; ++k)
+      for (int d = 0; d < 3; ++d) corners_[9 * static_cast<size_t>(i) + 3 * k + d] = V_(F_(order_[i], k), d);
 }
 
 int TriangleBvh::build_node(int first, int count, std::vector<Eigen::Vector3d>& centroids) {
@@ -147,8 +152,7 @@ ClosestPoint TriangleBvh::closest_point(const Eigen::Vector3d& p, double max_sq_
       for (int i = n.first; i < n.first + n.count; ++i) {
         const int f = order_[i];
         Eigen::Vector3d bary;
-        const Eigen::Vector3d q = closest_point_on_triangle(
-            p, V_.row(F_(f, 0)).transpose(), V_.row(F_(f, 1)).transpose(), V_.row(F_(f, 2)).transpose(), &bary);
+        const Eigen::Vector3d q = closest_point_on_triangle(p, corner(i, 0), corner(i, 1), corner(i, 2), &bary);
         const double d = (q - p).squaredNorm();
         if (d < best.sq_distance || (d == best.sq_distance && best.face >= 0 && f < best.face)) {
           best.sq_distance = d;
@@ -184,11 +188,8 @@ int TriangleBvh::ray_winding(const Eigen::Vector3d& p, const Eigen::Vector3d& di
     if (!spatial_detail::ray_hits_box(p, inv, std::numeric_limits<double>::infinity(), n.lo, n.hi)) continue;
     if (n.count > 0) {
       for (int i = n.first; i < n.first + n.count; ++i) {
-        const int f = order_[i];
         int sign = 0;
-        const double t = spatial_detail::ray_triangle(p, dir, V_.row(F_(f, 0)).transpose(),
-                                                      V_.row(F_(f, 1)).transpose(),
-                                                      V_.row(F_(f, 2)).transpose(), &sign);
+        const double t = spatial_detail::ray_triangle(p, dir, corner(i, 0), corner(i, 1), corner(i, 2), &sign);
         if (t > 0) winding += sign;
       }
       continue;
@@ -212,11 +213,8 @@ double TriangleBvh::ray_first_hit(const Eigen::Vector3d& p, const Eigen::Vector3
     if (!spatial_detail::ray_hits_box(p, inv, best, n.lo, n.hi)) continue;
     if (n.count > 0) {
       for (int i = n.first; i < n.first + n.count; ++i) {
-        const int f = order_[i];
         int sign = 0;
-        const double t = spatial_detail::ray_triangle(p, dir, V_.row(F_(f, 0)).transpose(),
-                                                      V_.row(F_(f, 1)).transpose(),
-                                                      V_.row(F_(f, 2)).transpose(), &sign);
+        const double t = spatial_detail::ray_triangle(p, dir, corner(i, 0), corner(i, 1), corner(i, 2), &sign);
         if (t > 1e-12 && t <= best) {
           best = t;
           hit = true;
@@ -230,17 +228,144 @@ double TriangleBvh::ray_first_hit(const Eigen::Vector3d& p, const Eigen::Vector3
   return hit ? best : -1;
 }
 
+namespace {
+
+// The inside test's rays: irrational-ish fixed directions so that they rarely graze edges of
+// axis-aligned models.
+constexpr double kInsideDirs[7][3] = {{0.5366, 0.7071, 0.4603},  {-0.6247, 0.3312, -0.7071},
+                                      {0.1118, -0.8944, 0.4331}, {-0.7771, -0.2213, 0.5893},
+                                      {0.8163, -0.3397, -0.4671}, {-0.2041, 0.9613, -0.1848},
+                                      {0.3015, 0.0745, -0.9505}};
+
+}  // namespace
+
+// Per inside ray direction d: the leaves' boxes projected along d onto a plane (orthonormal u, w
+// ⟂ d), each binned into the cells of a uniform 2D grid its projected bounding rectangle
+// overlaps. A ray p + s·d meets a box only if (p·u, p·w) lies in the box's projection, so the
+// leaves binned in p's cell are a superset of the leaves whose box the ray meets. Rectangles are
+// widened by 1e-9 of the scene's size, well above the rounding of the projections and of the
+// slab test. Each candidate leaf then gets the very slab test the tree's traversal gives it (a
+// leaf passing it has every ancestor passing: the ancestors' bounds are exact mins and maxes of
+// their children's, and the slab test is monotone in them) and the same ray–triangle tests, so
+// the winding is the traversal's — at a cost of one cell's leaves instead of every box the ray
+// crosses (michael3's retarget precompute spends a quarter of its time in these rays).
+struct TriangleBvh::InsideGrids {
+  struct Grid {
+    Eigen::Vector3d dir, u, w;
+    double u0 = 0, w0 = 0, inv_cell = 0;
+    int nu = 0, nw = 0;
+    std::vector<int> start;   // nu·nw + 1 offsets into leaves
+    std::vector<int> leaves;  // node ids
+  };
+  Grid grid[7];
+};
+
+const TriangleBvh::InsideGrids* TriangleBvh::inside_grids() const {
+  LazyInsideGrids& lazy = *inside_grids_;
+  if (lazy.ready.load(std::memory_order_acquire)) return lazy.grids.get();
+  if (lazy.tree_queries.fetch_add(1, std::memory_order_relaxed) < std::max<long>(1024, F_.rows())) return nullptr;
+  std::call_once(lazy.once, [&] {
+    auto g = std::make_unique<InsideGrids>();
+    std::vector<int> leaves;
+    for (size_t i = 0; i < nodes_.size(); ++i)
+      if (nodes_[i].count > 0) leaves.push_back(static_cast<int>(i));
+    const Node& root = nodes_[0];
+    const double scale = (root.hi - root.lo).norm() + root.lo.cwiseAbs().cwiseMax(root.hi.cwiseAbs()).maxCoeff();
+    const double margin = 1e-9 * scale + 1e-300;
+    const size_t nl = leaves.size();
+    std::vector<double> rect(4 * nl);  // umin, umax, wmin, wmax per leaf
+    for (int r = 0; r < 7; ++r) {
+      InsideGrids::Grid& G = g->grid[r];
+      G.dir = inside_direction(r);
+      const Eigen::Vector3d d = G.dir.normalized();
+      int a = 0;
+      d.cwiseAbs().minCoeff(&a);
+      G.u = d.cross(Eigen::Vector3d::Unit(a)).normalized();
+      G.w = d.cross(G.u).normalized();
+      double u_lo = std::numeric_limits<double>::infinity(), u_hi = -u_lo, w_lo = u_lo, w_hi = -u_lo;
+      for (size_t l = 0; l < nl; ++l) {
+        const Node& n = nodes_[leaves[l]];
+        double* q = &rect[4 * l];
+        q[0] = q[2] = std::numeric_limits<double>::infinity();
+        q[1] = q[3] = -std::numeric_limits<double>::infinity();
+        for (int c = 0; c < 8; ++c) {
+          const Eigen::Vector3d x((c & 1) ? n.hi[0] : n.lo[0], (c & 2) ? n.hi[1] : n.lo[1], (c & 4) ? n.hi[2] : n.lo[2]);
+          const double pu = x.dot(G.u), pw = x.dot(G.w);
+          q[0] = std::min(q[0], pu), q[1] = std::max(q[1], pu), q[2] = std::min(q[2], pw), q[3] = std::max(q[3], pw);
+        }
+        q[0] -= margin, q[1] += margin, q[2] -= margin, q[3] += margin;
+        u_lo = std::min(u_lo, q[0]), u_hi = std::max(u_hi, q[1]), w_lo = std::min(w_lo, q[2]), w_hi = std::max(w_hi, q[3]);
+      }
+      // About one cell per leaf, square cells, at most 2048 along a side.
+      const double eu = u_hi - u_lo, ew = w_hi - w_lo;
+      const double cell = std::max(std::sqrt(eu * ew / static_cast<double>(nl)), std::max(eu, ew) / 2048);
+      G.u0 = u_lo, G.w0 = w_lo, G.inv_cell = 1.0 / cell;
+      G.nu = std::clamp(static_cast<int>(eu * G.inv_cell) + 1, 1, 2049);
+      G.nw = std::clamp(static_cast<int>(ew * G.inv_cell) + 1, 1, 2049);
+      const auto cell_of = [&](double x, double x0, int n) {
+        return std::clamp(static_cast<int>(std::floor((x - x0) * G.inv_cell)), 0, n - 1);
+      };
+      G.start.assign(static_cast<size_t>(G.nu) * G.nw + 1, 0);
+      for (int pass = 0; pass < 2; ++pass) {
+        if (pass == 1) {
+          for (size_t c = 1; c < G.start.size(); ++c) G.start[c] += G.start[c - 1];
+          G.leaves.resize(G.start.back());
+        }
+        for (size_t l = 0; l < nl; ++l) {
+          const double* q = &rect[4 * l];
+          const int iu0 = cell_of(q[0], G.u0, G.nu), iu1 = cell_of(q[1], G.u0, G.nu);
+          const int iw0 = cell_of(q[2], G.w0, G.nw), iw1 = cell_of(q[3], G.w0, G.nw);
+          for (int iw = iw0; iw <= iw1; ++iw)
+            for (int iu = iu0; iu <= iu1; ++iu) {
+              const size_t c = static_cast<size_t>(iw) * G.nu + iu;
+              if (pass == 0) ++G.start[c + 1];
+              else G.leaves[G.start[c]++] = leaves[l];
+            }
+        }
+        if (pass == 1)  // fill advanced each start to the next cell's: shift back
+          for (size_t c = G.start.size() - 1; c > 0; --c) G.start[c] = G.start[c - 1];
+      }
+      G.start[0] = 0;
+    }
+    lazy.grids = std::move(g);
+    lazy.ready.store(true, std::memory_order_release);
+  });
+  return lazy.grids.get();
+}
+
+int TriangleBvh::grid_winding(const InsideGrids& g, int r, const Eigen::Vector3d& p) const {
+  const InsideGrids::Grid& G = g.grid[r];
+  const double fu = (p.dot(G.u) - G.u0) * G.inv_cell, fw = (p.dot(G.w) - G.w0) * G.inv_cell;
+  // Outside the grid (or not finite): no leaf's projection holds p, the ray meets no box.
+  if (!(fu >= 0 && fu < G.nu && fw >= 0 && fw < G.nw)) return 0;
+  const size_t c = static_cast<size_t>(static_cast<int>(fw)) * G.nu + static_cast<int>(fu);
+  const Eigen::Vector3d inv = G.dir.cwiseInverse();
+  int winding = 0;
+  for (int k = G.start[c]; k < G.start[c + 1]; ++k) {
+    const Node& n = nodes_[G.leaves[k]];
+    if (!spatial_detail::ray_hits_box(p, inv, std::numeric_limits<double>::infinity(), n.lo, n.hi)) continue;
+    for (int i = n.first; i < n.first + n.count; ++i) {
+      int sign = 0;
+      const double t = spatial_detail::ray_triangle(p, G.dir, corner(i, 0), corner(i, 1), corner(i, 2), &sign);
+      if (t > 0) winding += sign;
+    }
+  }
+  return winding;
+}
+
+Eigen::Vector3d TriangleBvh::inside_direction(int r) {
+  return Eigen::Vector3d(kInsideDirs[r][0], kInsideDirs[r][1], kInsideDirs[r][2]);
+}
+
 bool TriangleBvh::inside(const Eigen::Vector3d& p) const {
-  // Irrational-ish fixed directions so that rays rarely graze edges of axis-aligned models.
-  static const double dirs[7][3] = {{0.5366, 0.7071, 0.4603},  {-0.6247, 0.3312, -0.7071},
-                                    {0.1118, -0.8944, 0.4331}, {-0.7771, -0.2213, 0.5893},
-                                    {0.8163, -0.3397, -0.4671}, {-0.2041, 0.9613, -0.1848},
-                                    {0.3015, 0.0745, -0.9505}};
+  if (nodes_.empty()) return false;
+  const InsideGrids* g = inside_grids();
   // Majority of the seven rays, stopping as soon as the majority is decided (same answer; a
   // point clearly inside or outside casts four rays instead of seven).
   int votes = 0;
   for (int r = 0; r < 7; ++r) {
-    if (std::abs(ray_winding(p, Eigen::Vector3d(dirs[r][0], dirs[r][1], dirs[r][2]))) >= 1) ++votes;
+    const int w = g ? grid_winding(*g, r, p) : ray_winding(p, inside_direction(r));
+    if (std::abs(w) >= 1) ++votes;
     if (votes >= 4) return true;
     if (votes + (6 - r) < 4) return false;
   }
@@ -266,9 +391,7 @@ bool TriangleBvh::segment_hits(const Eigen::Vector3d& a, const Eigen::Vector3d& 
         const int f = order_[i];
         if (skip && skip(f)) continue;
         int sign = 0;
-        const double t = spatial_detail::ray_triangle(a, dir, V_.row(F_(f, 0)).transpose(),
-                                                      V_.row(F_(f, 1)).transpose(),
-                                                      V_.row(F_(f, 2)).transpose(), &sign);
+        const double t = spatial_detail::ray_triangle(a, dir, corner(i, 0), corner(i, 1), corner(i, 2), &sign);
         if (t > eps && t < 1.0 - eps) return true;
       }
       continue;
@@ -291,10 +414,10 @@ void TriangleBvh::for_each_overlapping(const Eigen::Vector3d& lo, const Eigen::V
     if (n.count > 0) {
       for (int i = n.first; i < n.first + n.count; ++i) {
         const int f = order_[i];
-        Eigen::Vector3d flo = V_.row(F_(f, 0)).transpose(), fhi = flo;
+        Eigen::Vector3d flo = corner(i, 0), fhi = flo;
         for (int k = 1; k < 3; ++k) {
-          flo = flo.cwiseMin(V_.row(F_(f, k)).transpose());
-          fhi = fhi.cwiseMax(V_.row(F_(f, k)).transpose());
+          flo = flo.cwiseMin(corner(i, k));
+          fhi = fhi.cwiseMax(corner(i, k));
         }
         if ((flo.array() > hi.array()).any() || (fhi.array() < lo.array()).any()) continue;
         visit(f);

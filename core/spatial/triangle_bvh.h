@@ -10,7 +10,10 @@
 #pragma once
 
 #include <functional>
+#include <atomic>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 #include <Eigen/Core>
@@ -53,8 +56,14 @@ class TriangleBvh {
                        double max_s = std::numeric_limits<double>::infinity()) const;
 
   // Inside test robust to small holes and to inverted parts: casts 7 fixed rays and says
-  // "inside" when most of them see |winding| ≥ 1.
+  // "inside" when most of them see |winding| ≥ 1. The rays are cast through a grid per
+  // direction, built on the first call (see InsideGrids in the .cpp): the same leaves and
+  // triangles are tested as by ray_winding, so the answer is the same.
   bool inside(const Eigen::Vector3d& p) const;
+  // The r-th of inside()'s 7 ray directions (r in 0..6).
+  static Eigen::Vector3d inside_direction(int r);
+  // True once inside() answers through its grids (for tests).
+  bool inside_grids_ready() const { return inside_grids_ && inside_grids_->ready.load(); }
 
   // True when the open segment a→b crosses a triangle (endpoints lying exactly on the surface
   // do not count). `skip` may exclude triangles (e.g. those incident to the endpoints).
@@ -75,11 +84,32 @@ class TriangleBvh {
     int first = 0, count = 0;   // range in order_ (leaves: count > 0)
   };
   int build_node(int first, int count, std::vector<Eigen::Vector3d>& centroids);
+  struct InsideGrids;
+  // Built once, by whichever thread gets there, after inside() has cast max(1024, #F) queries on
+  // the tree (building costs about as much as that many queries save: a mesh asked a few times
+  // never pays for it).
+  struct LazyInsideGrids {
+    std::atomic<long> tree_queries{0};
+    std::atomic<bool> ready{false};
+    std::once_flag once;
+    std::unique_ptr<const InsideGrids> grids;
+  };
+  const InsideGrids* inside_grids() const;  // null while the tree answers
+  int grid_winding(const InsideGrids& g, int r, const Eigen::Vector3d& p) const;
 
   Eigen::MatrixXd V_;
   Eigen::MatrixXi F_;
   std::vector<Node> nodes_;
   std::vector<int> order_;  // triangle indices, leaves reference ranges of it
+  // The triangles' corners in order_'s order, 9 coordinates each (a, b, c), so a leaf's
+  // triangles are read from one contiguous block instead of three strided rows of V_ per
+  // triangle (V_ is column-major). The same values as V_'s: every query gives the same bits.
+  std::vector<double> corners_;
+  // Shared by copies of the tree (the grids describe the same triangles); replaced by build().
+  std::shared_ptr<LazyInsideGrids> inside_grids_;
+  Eigen::Map<const Eigen::Vector3d> corner(int i, int k) const {
+    return Eigen::Map<const Eigen::Vector3d>(corners_.data() + 9 * static_cast<size_t>(i) + 3 * k);
+  }
 };
 
 // Closest point on triangle (a, b, c) to p, with barycentric weights (Ericson, Real-Time
