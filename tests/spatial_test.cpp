@@ -164,7 +164,7 @@ TEST(SpatialBvh, InsideGridsAnswerAsTheRayTraversal) {
     }
     pts.push_back(lo - 10 * diag * Eigen::Vector3d::Ones());
     pts.push_back(hi + 1e3 * diag * Eigen::Vector3d(1, -2, 3));
-    // The grids are built after max(1024, #F) queries on the tree: ask until they are, then once more.
+    // The grids are built after max(256, #F / 8) queries on the tree: ask until they are, then once more.
     int n_inside = 0, mismatches = 0;
     for (int pass = 0; pass < 100; ++pass) {
       const bool ready = bvh.inside_grids_ready();

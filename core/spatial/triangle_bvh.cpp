@@ -83,10 +83,6 @@ void TriangleBvh::build(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   }
   nodes_.reserve(2 * F.rows() / spatial_detail::kLeafSize + 2);
   build_node(0, static_cast<int>(F.rows()), centroids);
-  corners_.resize(9 * static_cast<size_t>(F.rows()));
-  for (Eigen::Index i = 0; i < F.rows(); ++i)
-    for (int k = 0; k < 3; ++k)
-      for (int d = 0; d < 3; ++d) corners_[9 * static_cast<size_t>(i) + 3 * k + d] = V_(F_(order_[i], k), d);
 }
 
 int TriangleBvh::build_node(int first, int count, std::vector<Eigen::Vector3d>& centroids) {
@@ -263,7 +259,7 @@ struct TriangleBvh::InsideGrids {
 const TriangleBvh::InsideGrids* TriangleBvh::inside_grids() const {
   LazyInsideGrids& lazy = *inside_grids_;
   if (lazy.ready.load(std::memory_order_acquire)) return lazy.grids.get();
-  if (lazy.tree_queries.fetch_add(1, std::memory_order_relaxed) < std::max<long>(1024, F_.rows())) return nullptr;
+  if (lazy.tree_queries.fetch_add(1, std::memory_order_relaxed) < std::max<long>(256, F_.rows() / 8)) return nullptr;
   std::call_once(lazy.once, [&] {
     auto g = std::make_unique<InsideGrids>();
     std::vector<int> leaves;
