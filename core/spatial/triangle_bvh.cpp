@@ -76,16 +76,20 @@ void TriangleBvh::build(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   inside_grids_ = std::make_shared<LazyInsideGrids>();
   order_.resize(F.rows());
   if (F.rows() == 0) return;
-  std::vector<Eigen::Vector3d> centroids(F.rows());
+  // Centroids travel with their triangle's index, so partitioning reads them in sequence (this
+  // used to sort indices into a separate centroid array: the same comparisons on the same
+  // sequence, so the same tree and the same order_, without a cache miss per comparison).
+  std::vector<BuildItem> items(F.rows());
   for (int f = 0; f < F.rows(); ++f) {
-    order_[f] = f;
-    centroids[f] = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))).transpose() / 3.0;
+    const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))).transpose() / 3.0;
+    items[f] = {{c[0], c[1], c[2]}, f};
   }
   nodes_.reserve(2 * F.rows() / spatial_detail::kLeafSize + 2);
-  build_node(0, static_cast<int>(F.rows()), centroids);
+  build_node(0, static_cast<int>(F.rows()), items);
+  for (int i = 0; i < F.rows(); ++i) order_[i] = items[i].f;
 }
 
-int TriangleBvh::build_node(int first, int count, std::vector<Eigen::Vector3d>& centroids) {
+int TriangleBvh::build_node(int first, int count, std::vector<BuildItem>& items) {
   // Nodes in pre-order; a leaf's box from its triangles, an inner node's as the union of its
   // children's (the same box as from all its triangles: min and max are exact), so each triangle
   // is read once, not once per level.
@@ -97,7 +101,7 @@ int TriangleBvh::build_node(int first, int count, std::vector<Eigen::Vector3d>& 
     node.hi.setConstant(-std::numeric_limits<double>::infinity());
     for (int i = first; i < first + count; ++i)
       for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector3d v = V_.row(F_(order_[i], k)).transpose();
+        const Eigen::Vector3d v = V_.row(F_(items[i].f, k)).transpose();
         node.lo = node.lo.cwiseMin(v);
         node.hi = node.hi.cwiseMax(v);
       }
@@ -105,22 +109,19 @@ int TriangleBvh::build_node(int first, int count, std::vector<Eigen::Vector3d>& 
     node.count = count;
     return id;
   }
-  Eigen::Vector3d clo = centroids[order_[first]], chi = clo;
-  for (int i = first; i < first + count; ++i) {
-    clo = clo.cwiseMin(centroids[order_[i]]);
-    chi = chi.cwiseMax(centroids[order_[i]]);
-  }
+  double clo[3] = {items[first].c[0], items[first].c[1], items[first].c[2]}, chi[3] = {clo[0], clo[1], clo[2]};
+  for (int i = first; i < first + count; ++i)
+    for (int k = 0; k < 3; ++k) clo[k] = std::min(clo[k], items[i].c[k]), chi[k] = std::max(chi[k], items[i].c[k]);
   int axis = 0;
-  (chi - clo).maxCoeff(&axis);
+  Eigen::Vector3d(chi[0] - clo[0], chi[1] - clo[1], chi[2] - clo[2]).maxCoeff(&axis);
   const int mid = first + count / 2;
   // Ties broken by triangle index keep the tree independent of std::nth_element internals.
-  std::nth_element(order_.begin() + first, order_.begin() + mid, order_.begin() + first + count,
-                   [&](int a, int b) {
-                     const double ca = centroids[a][axis], cb = centroids[b][axis];
-                     return ca < cb || (ca == cb && a < b);
+  std::nth_element(items.begin() + first, items.begin() + mid, items.begin() + first + count,
+                   [axis](const BuildItem& a, const BuildItem& b) {
+                     return a.c[axis] < b.c[axis] || (a.c[axis] == b.c[axis] && a.f < b.f);
                    });
-  const int left = build_node(first, mid - first, centroids);
-  const int right = build_node(mid, first + count - mid, centroids);
+  const int left = build_node(first, mid - first, items);
+  const int right = build_node(mid, first + count - mid, items);
   Node& node = nodes_[id];
   node.left = left;
   node.right = right;
