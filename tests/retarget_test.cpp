@@ -127,6 +127,21 @@ TEST(RetargetKernel, TransposedProductIsTheSameOnAnyThreadCount) {
   EXPECT_TRUE(out[0] == out[1]);
   EXPECT_TRUE(out[0] == out[2]);
   EXPECT_LT((out[0] - Mt.transpose() * B).cwiseAbs().maxCoeff(), 1e-12);
+  // The summation order is fixed (even terms, odd terms, then their sum; the SIMD lanes are the
+  // two chains), so native and wasm give the same bits: equal to this plain loop, for an even and
+  // an odd number of terms.
+  for (const int k : {263, 264}) {
+    const Eigen::MatrixXd M2 = Eigen::MatrixXd::Random(k, 501), B2 = Eigen::MatrixXd::Random(k, 3);
+    const Eigen::MatrixXd got = mm::transposed_times_n3(M2, B2);
+    Eigen::MatrixXd want(M2.cols(), 3);
+    for (int j = 0; j < M2.cols(); ++j)
+      for (int c = 0; c < 3; ++c) {
+        double even = 0, odd = 0;
+        for (int i = 0; i < k; ++i) (i % 2 == 0 ? even : odd) += M2(i, j) * B2(i, c);
+        want(j, c) = even + odd;
+      }
+    EXPECT_TRUE(got == want) << k << " terms: max difference " << (got - want).cwiseAbs().maxCoeff();
+  }
 }
 
 TEST(RetargetHarmonicMap, FitsRigidAndBentTube) {
