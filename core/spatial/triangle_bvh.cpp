@@ -173,6 +173,16 @@ ClosestPoint TriangleBvh::closest_point(const Eigen::Vector3d& p, double max_sq_
   return best;
 }
 
+int TriangleBvh::leaf_winding(const Node& n, const Eigen::Vector3d& p, const Eigen::Vector3d& dir) const {
+  int winding = 0;
+  for (int i = n.first; i < n.first + n.count; ++i) {
+    int sign = 0;
+    const double t = spatial_detail::ray_triangle(p, dir, corner(i, 0), corner(i, 1), corner(i, 2), &sign);
+    if (t > 0) winding += sign;
+  }
+  return winding;
+}
+
 int TriangleBvh::ray_winding(const Eigen::Vector3d& p, const Eigen::Vector3d& dir) const {
   if (nodes_.empty()) return 0;
   const Eigen::Vector3d inv = dir.cwiseInverse();
@@ -184,11 +194,7 @@ int TriangleBvh::ray_winding(const Eigen::Vector3d& p, const Eigen::Vector3d& di
     const Node& n = nodes_[stack[--top]];
     if (!spatial_detail::ray_hits_box(p, inv, std::numeric_limits<double>::infinity(), n.lo, n.hi)) continue;
     if (n.count > 0) {
-      for (int i = n.first; i < n.first + n.count; ++i) {
-        int sign = 0;
-        const double t = spatial_detail::ray_triangle(p, dir, corner(i, 0), corner(i, 1), corner(i, 2), &sign);
-        if (t > 0) winding += sign;
-      }
+      winding += leaf_winding(n, p, dir);
       continue;
     }
     stack[top++] = n.left;
@@ -302,27 +308,20 @@ const TriangleBvh::InsideGrids* TriangleBvh::inside_grids() const {
       const auto cell_of = [&](double x, double x0, int n) {
         return std::clamp(static_cast<int>(std::floor((x - x0) * G.inv_cell)), 0, n - 1);
       };
+      // Cells as CSR: count the leaves per cell, prefix sums, then fill through a cursor per cell.
       G.start.assign(static_cast<size_t>(G.nu) * G.nw + 1, 0);
-      for (int pass = 0; pass < 2; ++pass) {
-        if (pass == 1) {
-          for (size_t c = 1; c < G.start.size(); ++c) G.start[c] += G.start[c - 1];
-          G.leaves.resize(G.start.back());
-        }
-        for (size_t l = 0; l < nl; ++l) {
-          const double* q = &rect[4 * l];
-          const int iu0 = cell_of(q[0], G.u0, G.nu), iu1 = cell_of(q[1], G.u0, G.nu);
-          const int iw0 = cell_of(q[2], G.w0, G.nw), iw1 = cell_of(q[3], G.w0, G.nw);
-          for (int iw = iw0; iw <= iw1; ++iw)
-            for (int iu = iu0; iu <= iu1; ++iu) {
-              const size_t c = static_cast<size_t>(iw) * G.nu + iu;
-              if (pass == 0) ++G.start[c + 1];
-              else G.leaves[G.start[c]++] = leaves[l];
-            }
-        }
-        if (pass == 1)  // fill advanced each start to the next cell's: shift back
-          for (size_t c = G.start.size() - 1; c > 0; --c) G.start[c] = G.start[c - 1];
-      }
-      G.start[0] = 0;
+      const auto for_each_cell = [&](size_t l, const auto& visit) {
+        const double* q = &rect[4 * l];
+        const int iu0 = cell_of(q[0], G.u0, G.nu), iu1 = cell_of(q[1], G.u0, G.nu);
+        const int iw0 = cell_of(q[2], G.w0, G.nw), iw1 = cell_of(q[3], G.w0, G.nw);
+        for (int iw = iw0; iw <= iw1; ++iw)
+          for (int iu = iu0; iu <= iu1; ++iu) visit(static_cast<size_t>(iw) * G.nu + iu);
+      };
+      for (size_t l = 0; l < nl; ++l) for_each_cell(l, [&](size_t c) { ++G.start[c + 1]; });
+      for (size_t c = 1; c < G.start.size(); ++c) G.start[c] += G.start[c - 1];
+      G.leaves.resize(G.start.back());
+      std::vector<int> cursor(G.start.begin(), G.start.end() - 1);
+      for (size_t l = 0; l < nl; ++l) for_each_cell(l, [&](size_t c) { G.leaves[cursor[c]++] = leaves[l]; });
     }
     lazy.grids = std::move(g);
     lazy.ready.store(true, std::memory_order_release);
@@ -340,12 +339,8 @@ int TriangleBvh::grid_winding(const InsideGrids& g, int r, const Eigen::Vector3d
   int winding = 0;
   for (int k = G.start[c]; k < G.start[c + 1]; ++k) {
     const Node& n = nodes_[G.leaves[k]];
-    if (!spatial_detail::ray_hits_box(p, inv, std::numeric_limits<double>::infinity(), n.lo, n.hi)) continue;
-    for (int i = n.first; i < n.first + n.count; ++i) {
-      int sign = 0;
-      const double t = spatial_detail::ray_triangle(p, G.dir, corner(i, 0), corner(i, 1), corner(i, 2), &sign);
-      if (t > 0) winding += sign;
-    }
+    if (spatial_detail::ray_hits_box(p, inv, std::numeric_limits<double>::infinity(), n.lo, n.hi))
+      winding += leaf_winding(n, p, G.dir);
   }
   return winding;
 }

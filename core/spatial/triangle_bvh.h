@@ -100,6 +100,8 @@ class TriangleBvh {
   };
   const InsideGrids* inside_grids() const;  // null while the tree answers
   int grid_winding(const InsideGrids& g, int r, const Eigen::Vector3d& p) const;
+  // Signed crossings of the ray p + s·dir (s > 0) with a leaf's triangles (its box not tested).
+  int leaf_winding(const Node& n, const Eigen::Vector3d& p, const Eigen::Vector3d& dir) const;
 
   Eigen::MatrixXd V_;
   Eigen::MatrixXi F_;
