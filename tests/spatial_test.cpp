@@ -10,7 +10,9 @@
 #include <cmath>
 #include <vector>
 
+#include "common/threads.h"
 #include "io/asset.h"
+#include "mesh/midpoint_subdivide.h"
 #include "spatial/farthest_point_sampling.h"
 #include "spatial/quadric.h"
 #include "spatial/triangle_bvh.h"
@@ -185,6 +187,39 @@ TEST(SpatialBvh, InsideGridsAnswerAsTheRayTraversal) {
   }
   EXPECT_FALSE(mm::TriangleBvh().inside({0, 0, 0}));
   EXPECT_FALSE(mm::TriangleBvh(meshes.back().V, meshes.back().F).inside({std::nan(""), 0.5, 0.5}));
+}
+
+// From 16,384 triangles up, with two threads the root's halves are built on two threads; the node
+// array (pre-order) and the triangle order are the same as on one thread.
+TEST(SpatialBvh, TheBuildGivesTheSameTreeOnAnyThreadCount) {
+  const mm::io::LoadResult r = mm::io::load_asset(mm::test::data_path("anim/human_woman.ply"));
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
+  const mm::Mesh m{r.asset.V_raw, r.asset.F_raw};
+  const mm::Mesh fine = mm::midpoint_subdivide(m);  // 55k triangles
+  ASSERT_GE(fine.F.rows(), 3 * 16384);
+  for (const mm::Mesh* mesh : {&m, &fine}) {
+    std::uint64_t h[3];
+    const int counts[3] = {1, 2, 4};
+    std::vector<mm::ClosestPoint> answers[3];
+    for (int t = 0; t < 3; ++t) {
+      mm::set_max_threads(counts[t]);
+      const mm::TriangleBvh bvh(mesh->V, mesh->F);
+      h[t] = bvh.fingerprint();
+      for (int v = 0; v < mesh->V.rows(); v += 97) answers[t].push_back(bvh.closest_point(mesh->V.row(v).transpose() * 1.01));
+    }
+    mm::set_max_threads(0);
+    EXPECT_EQ(h[0], h[1]) << mesh->F.rows() << " triangles";
+    EXPECT_EQ(h[0], h[2]) << mesh->F.rows() << " triangles";
+    for (int t = 1; t < 3; ++t)
+      for (size_t i = 0; i < answers[0].size(); ++i) {
+        ASSERT_EQ(answers[0][i].face, answers[t][i].face);
+        ASSERT_EQ(answers[0][i].sq_distance, answers[t][i].sq_distance);
+      }
+  }
+  // The hash sees the tree: a different mesh (one vertex moved) gives another.
+  mm::Mesh moved = fine;
+  moved.V(0, 0) += 1e-9;
+  EXPECT_NE(mm::TriangleBvh(fine.V, fine.F).fingerprint(), mm::TriangleBvh(moved.V, moved.F).fingerprint());
 }
 
 TEST(SpatialBvh, SegmentHits) {

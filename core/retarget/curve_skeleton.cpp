@@ -1,6 +1,9 @@
 #include "retarget/curve_skeleton.h"
 
+#include "common/threads.h"
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -136,18 +139,22 @@ std::vector<uint8_t> cs_dilate(const CsGrid& g, const std::vector<uint8_t>& mask
     const int n = dims[axis];
     const size_t st = stride[axis];
     const int o1 = (axis + 1) % 3, o2 = (axis + 2) % 3;
-    for (int v = 0; v < dims[o2]; ++v)
-      for (int u = 0; u < dims[o1]; ++u) {
-        const size_t base = size_t(u) * stride[o1] + size_t(v) * stride[o2];
-        // count = ones in [x − k, x + k] ∩ [0, n).
-        int count = 0;
-        for (int x = 0; x < std::min(k, n); ++x) count += a[base + x * st];
-        for (int x = 0; x < n; ++x) {
-          if (x + k < n) count += a[base + (x + k) * st];
-          if (x - k - 1 >= 0) count -= a[base + (x - k - 1) * st];
-          b[base + x * st] = count > 0;
+    // Lines are independent: blocks of planes on the task threads (≥ 64k cells a block).
+    const long plane = long(dims[o1]) * n;
+    parallel_blocks(dims[o2], std::max(1L, 65536 / std::max(1L, plane)), [&](long v0, long v1) {
+      for (long v = v0; v < v1; ++v)
+        for (int u = 0; u < dims[o1]; ++u) {
+          const size_t base = size_t(u) * stride[o1] + size_t(v) * stride[o2];
+          // count = ones in [x − k, x + k] ∩ [0, n).
+          int count = 0;
+          for (int x = 0; x < std::min(k, n); ++x) count += a[base + x * st];
+          for (int x = 0; x < n; ++x) {
+            if (x + k < n) count += a[base + (x + k) * st];
+            if (x - k - 1 >= 0) count -= a[base + (x - k - 1) * st];
+            b[base + x * st] = count > 0;
+          }
         }
-      }
+    });
     a.swap(b);
   }
   return a;
@@ -337,12 +344,37 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   const int no_offset[3] = {0, 0, 0};
   std::vector<uint8_t> surf(g.size(), 0);
   {
+    // With a second thread, the second half of the triangles is marked on a grid of its own by a
+    // pool task, then the two grids are joined (a cell is marked by either: the same grid).
+    const int nf = int(F.rows());
+    const int split = MM_HAS_THREADS && max_threads() > 1 && nf >= 8192 ? nf / 2 : nf;
+    std::vector<uint8_t> surf2;
+    std::atomic<bool> stop{false};
+    Task second;
+    if (split < nf) {
+      surf2.assign(g.size(), 0);
+      second = Task([&, split, nf] {
+        std::vector<int> chunk;
+        for (int f0 = split; f0 < nf && !stop.load(); f0 += 4096) {
+          chunk.clear();
+          for (int f = f0; f < std::min(f0 + 4096, nf); ++f) chunk.push_back(f);
+          cs_rasterize(V, F, chunk, glo, h, no_offset, g, &surf2);
+        }
+      });
+    }
     std::vector<int> chunk;
-    for (int f0 = 0; f0 < F.rows(); f0 += 4096) {
-      if (!progress.update("skeleton: voxels", 0.3 * f0 / F.rows())) return fail(StatusCode::Cancelled, "cancelled during skeleton: voxels");
+    for (int f0 = 0; f0 < split; f0 += 4096) {
+      if (!progress.update("skeleton: voxels", 0.3 * f0 / split)) {
+        stop.store(true);
+        return fail(StatusCode::Cancelled, "cancelled during skeleton: voxels");
+      }
       chunk.clear();
-      for (int f = f0; f < std::min<int>(f0 + 4096, int(F.rows())); ++f) chunk.push_back(f);
+      for (int f = f0; f < std::min(f0 + 4096, split); ++f) chunk.push_back(f);
       cs_rasterize(V, F, chunk, glo, h, no_offset, g, &surf);
+    }
+    if (second.valid()) {
+      second.wait();
+      for (size_t i = 0; i < surf.size(); ++i) surf[i] |= surf2[i];
     }
   }
   std::vector<uint8_t>& solid = vs.solid;
@@ -412,8 +444,8 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
     const int np = int(part_faces.size());
     if (np >= 3 && np <= 64) {
       std::vector<uint64_t> mask(g.size(), 0);
-      for (int p = 0; p < np; ++p) {
-        if (!progress.update("skeleton: parts", 0.4 + 0.05 * p / np)) return fail(StatusCode::Cancelled, "cancelled during skeleton: parts");
+      // Part p's own solid, marked as bit p of the cells it shares with the union.
+      auto add_part = [&](int p, std::vector<uint64_t>* m) {
         Eigen::Vector3d plo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), phi = -plo;
         for (int f : part_faces[p])
           for (int k = 0; k < 3; ++k) {
@@ -434,8 +466,35 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
           int x, y, z;
           sub.xyz(i, &x, &y, &z);
           const size_t j = g.idx(x + off[0], y + off[1], z + off[2]);
-          if (solid[j]) mask[j] |= uint64_t(1) << p;
+          if (solid[j]) (*m)[j] |= uint64_t(1) << p;
         }
+      };
+      // With a second thread, the parts holding the second half of the triangles are done on a pool
+      // task into a mask of its own, joined after (the bits are the same either way).
+      int split = np;
+      if (MM_HAS_THREADS && max_threads() > 1 && F.rows() >= 8192) {
+        long acc = 0;
+        for (split = 0; split < np && 2 * acc < F.rows(); ++split) acc += long(part_faces[split].size());
+      }
+      std::vector<uint64_t> mask2;
+      std::atomic<bool> stop{false};
+      Task second;
+      if (split < np) {
+        mask2.assign(g.size(), 0);
+        second = Task([&, split] {
+          for (int p = split; p < np && !stop.load(); ++p) add_part(p, &mask2);
+        });
+      }
+      for (int p = 0; p < split; ++p) {
+        if (!progress.update("skeleton: parts", 0.4 + 0.05 * p / np)) {
+          stop.store(true);
+          return fail(StatusCode::Cancelled, "cancelled during skeleton: parts");
+        }
+        add_part(p, &mask);
+      }
+      if (second.valid()) {
+        second.wait();
+        for (size_t i = 0; i < mask.size(); ++i) mask[i] |= mask2[i];
       }
       // Owner of each solid cell: the lowest part holding it; cells of no part (gaps the closing
       // filled, bridges) take the part that reaches them first, breadth-first in scan order.

@@ -1,6 +1,7 @@
 #include "retarget/joint_fitting.h"
 
 #include <algorithm>
+#include <atomic>
 #include <functional>
 #include <cmath>
 #include <cstdio>
@@ -8,6 +9,7 @@
 #include <map>
 #include <optional>
 
+#include "common/threads.h"
 #include "retarget/bone_blend.h"
 #include "spatial/triangle_bvh.h"
 #include "spatial/uniform_grid.h"
@@ -1225,15 +1227,45 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
       (opt.target_up >= 0 && opt.target_front >= 0 && opt.target_up % 3 == opt.target_front % 3))
     return fail(StatusCode::InvalidArgument, "up axes must be -1 (target: detect) or 0..5 (+x, +y, +z, -x, -y, -z)");
   if (source_joints.size() < 2) return fail(StatusCode::InvalidArgument, "the source has fewer than 2 joints");
-  r.source_skeleton = curve_skeleton(Vs, Fs, opt.skeleton, progress.sub(0, 0.45));
-  if (!r.source_skeleton.status.ok())
-    return fail(r.source_skeleton.status.code, "source skeleton: " + r.source_skeleton.status.message);
-  r.target_skeleton = curve_skeleton(Vt, Ft, opt.skeleton, progress.sub(0.45, 0.9));
-  if (!r.target_skeleton.status.ok())
-    return fail(r.target_skeleton.status.code, "target skeleton: " + r.target_skeleton.status.message);
+  // The two curve skeletons and surface trees are independent: with a second thread, the source's
+  // are built on a pool task while this thread builds the target's (same results either way; only
+  // this thread reports progress, and the task stops when this thread returns early).
+  TriangleBvh bvh_s, bvh_t;
+  {
+    CurveSkeleton source_skeleton;  // the task's (r is copied by an early return while it may run)
+    std::atomic<bool> stop{false};
+    struct StopOnExit {
+      std::atomic<bool>& flag;
+      ~StopOnExit() { flag.store(true); }
+    };
+    Task source_task;  // declared after what it writes: an early return waits for it (destructor)
+    const StopOnExit stop_on_exit{stop};
+    const bool overlap = MM_HAS_THREADS && max_threads() > 1;
+    if (overlap) {
+      const Progress watch([&stop](const std::string&, double) { return !stop.load(); });
+      source_task = Task([&source_skeleton, &bvh_s, &Vs, &Fs, &opt, watch] {
+        source_skeleton = curve_skeleton(Vs, Fs, opt.skeleton, watch);
+        if (source_skeleton.status.ok()) bvh_s.build(Vs, Fs);
+      });
+    } else {
+      r.source_skeleton = curve_skeleton(Vs, Fs, opt.skeleton, progress.sub(0, 0.45));
+      if (!r.source_skeleton.status.ok())
+        return fail(r.source_skeleton.status.code, "source skeleton: " + r.source_skeleton.status.message);
+      bvh_s.build(Vs, Fs);
+    }
+    r.target_skeleton = curve_skeleton(Vt, Ft, opt.skeleton, progress.sub(overlap ? 0.0 : 0.45, 0.9));
+    if (!r.target_skeleton.status.ok())
+      return fail(r.target_skeleton.status.code, "target skeleton: " + r.target_skeleton.status.message);
+    bvh_t.build(Vt, Ft);
+    if (source_task.valid()) {
+      source_task.wait();
+      r.source_skeleton = std::move(source_skeleton);
+      if (!r.source_skeleton.status.ok())
+        return fail(r.source_skeleton.status.code, "source skeleton: " + r.source_skeleton.status.message);
+    }
+  }
 
   // Source joints inside the source surface.
-  TriangleBvh bvh_s(Vs, Fs), bvh_t(Vt, Ft);
   const double tol_s = opt.inside_tolerance * (Vs.colwise().maxCoeff() - Vs.colwise().minCoeff()).norm();
   const double tol_t = opt.inside_tolerance * (Vt.colwise().maxCoeff() - Vt.colwise().minCoeff()).norm();
   auto inside_s = [&](const Eigen::Vector3d& p) { return bvh_s.closest_point(p).sq_distance <= tol_s * tol_s || bvh_s.inside(p); };

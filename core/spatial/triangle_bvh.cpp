@@ -1,9 +1,11 @@
 #include "spatial/triangle_bvh.h"
 
+#include "common/threads.h"
 #include "spatial/point_triangle.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace mm {
 
@@ -69,6 +71,9 @@ Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen:
   return q;
 }
 
+// Below this many triangles the build takes < ~2 ms on one thread and is not split.
+constexpr int kParallelBuild = 16384;
+
 void TriangleBvh::build(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   V_ = V;
   F_ = F;
@@ -84,19 +89,76 @@ void TriangleBvh::build(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
     const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))).transpose() / 3.0;
     items[f] = {{c[0], c[1], c[2]}, f};
   }
-  nodes_.reserve(2 * F.rows() / spatial_detail::kLeafSize + 2);
-  build_node(0, static_cast<int>(F.rows()), items);
-  for (int i = 0; i < F.rows(); ++i) order_[i] = items[i].f;
+  const int n = static_cast<int>(F.rows());
+  nodes_.reserve(2 * n / spatial_detail::kLeafSize + 2);
+  if (n < kParallelBuild || max_threads() < 2) {
+    build_node(nodes_, 0, n, items);
+  } else {
+    // Two threads: the root's halves are built apart, the right one into a node array of its own
+    // that is appended after the left one with its child ids shifted. Pre-order puts the whole left
+    // subtree before the right one, so the nodes, their ids and order_ are those of one thread.
+    nodes_.emplace_back();
+    const int mid = split_items(0, n, items);
+    std::vector<Node> right_nodes;
+    right_nodes.reserve(2 * (n - mid) / spatial_detail::kLeafSize + 2);
+    Task right([this, &right_nodes, mid, n, &items] { build_node(right_nodes, mid, n - mid, items); });
+    const int left = build_node(nodes_, 0, mid, items);
+    right.wait();
+    const int shift = static_cast<int>(nodes_.size());
+    for (Node& node : right_nodes)
+      if (node.count == 0) node.left += shift, node.right += shift;
+    nodes_.insert(nodes_.end(), right_nodes.begin(), right_nodes.end());
+    Node& root = nodes_[0];
+    root.left = left;
+    root.right = shift;
+    root.lo = nodes_[left].lo.cwiseMin(nodes_[shift].lo);
+    root.hi = nodes_[left].hi.cwiseMax(nodes_[shift].hi);
+  }
+  for (int i = 0; i < n; ++i) order_[i] = items[i].f;
 }
 
-int TriangleBvh::build_node(int first, int count, std::vector<BuildItem>& items) {
+std::uint64_t TriangleBvh::fingerprint() const {
+  std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the words below
+  auto mix = [&h](std::uint64_t w) {
+    for (int b = 0; b < 8; ++b) h = (h ^ ((w >> (8 * b)) & 0xff)) * 1099511628211ull;
+  };
+  auto bits = [](double x) {
+    std::uint64_t w;
+    std::memcpy(&w, &x, sizeof w);
+    return w;
+  };
+  for (const Node& n : nodes_) {
+    for (int k = 0; k < 3; ++k) mix(bits(n.lo[k])), mix(bits(n.hi[k]));
+    mix(std::uint64_t(std::uint32_t(n.left)) << 32 | std::uint32_t(n.right));
+    mix(std::uint64_t(std::uint32_t(n.first)) << 32 | std::uint32_t(n.count));
+  }
+  for (int f : order_) mix(std::uint32_t(f));
+  return h;
+}
+
+int TriangleBvh::split_items(int first, int count, std::vector<BuildItem>& items) {
+  double clo[3] = {items[first].c[0], items[first].c[1], items[first].c[2]}, chi[3] = {clo[0], clo[1], clo[2]};
+  for (int i = first; i < first + count; ++i)
+    for (int k = 0; k < 3; ++k) clo[k] = std::min(clo[k], items[i].c[k]), chi[k] = std::max(chi[k], items[i].c[k]);
+  int axis = 0;
+  Eigen::Vector3d(chi[0] - clo[0], chi[1] - clo[1], chi[2] - clo[2]).maxCoeff(&axis);
+  const int mid = first + count / 2;
+  // Ties broken by triangle index keep the tree independent of std::nth_element internals.
+  std::nth_element(items.begin() + first, items.begin() + mid, items.begin() + first + count,
+                   [axis](const BuildItem& a, const BuildItem& b) {
+                     return a.c[axis] < b.c[axis] || (a.c[axis] == b.c[axis] && a.f < b.f);
+                   });
+  return mid;
+}
+
+int TriangleBvh::build_node(std::vector<Node>& nodes, int first, int count, std::vector<BuildItem>& items) const {
   // Nodes in pre-order; a leaf's box from its triangles, an inner node's as the union of its
   // children's (the same box as from all its triangles: min and max are exact), so each triangle
   // is read once, not once per level.
-  const int id = static_cast<int>(nodes_.size());
-  nodes_.emplace_back();
+  const int id = static_cast<int>(nodes.size());
+  nodes.emplace_back();
   if (count <= spatial_detail::kLeafSize) {
-    Node& node = nodes_[id];
+    Node& node = nodes[id];
     node.lo.setConstant(std::numeric_limits<double>::infinity());
     node.hi.setConstant(-std::numeric_limits<double>::infinity());
     for (int i = first; i < first + count; ++i)
@@ -109,24 +171,14 @@ int TriangleBvh::build_node(int first, int count, std::vector<BuildItem>& items)
     node.count = count;
     return id;
   }
-  double clo[3] = {items[first].c[0], items[first].c[1], items[first].c[2]}, chi[3] = {clo[0], clo[1], clo[2]};
-  for (int i = first; i < first + count; ++i)
-    for (int k = 0; k < 3; ++k) clo[k] = std::min(clo[k], items[i].c[k]), chi[k] = std::max(chi[k], items[i].c[k]);
-  int axis = 0;
-  Eigen::Vector3d(chi[0] - clo[0], chi[1] - clo[1], chi[2] - clo[2]).maxCoeff(&axis);
-  const int mid = first + count / 2;
-  // Ties broken by triangle index keep the tree independent of std::nth_element internals.
-  std::nth_element(items.begin() + first, items.begin() + mid, items.begin() + first + count,
-                   [axis](const BuildItem& a, const BuildItem& b) {
-                     return a.c[axis] < b.c[axis] || (a.c[axis] == b.c[axis] && a.f < b.f);
-                   });
-  const int left = build_node(first, mid - first, items);
-  const int right = build_node(mid, first + count - mid, items);
-  Node& node = nodes_[id];
+  const int mid = split_items(first, count, items);
+  const int left = build_node(nodes, first, mid - first, items);
+  const int right = build_node(nodes, mid, first + count - mid, items);
+  Node& node = nodes[id];
   node.left = left;
   node.right = right;
-  node.lo = nodes_[left].lo.cwiseMin(nodes_[right].lo);
-  node.hi = nodes_[left].hi.cwiseMax(nodes_[right].hi);
+  node.lo = nodes[left].lo.cwiseMin(nodes[right].lo);
+  node.hi = nodes[left].hi.cwiseMax(nodes[right].hi);
   return id;
 }
 
