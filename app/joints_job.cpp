@@ -40,6 +40,8 @@ const OptionSchema<JointsJobOptions>& joints_options() {
              "weight of the source's bones (scaled to the target) against the fitted joints, for a target of the source's rig family (0 = off)");
     s.number("skeleton_prior_agreement", [](O& o) -> double& { return o.fit.skeleton_prior_agreement; }, 0, 10,
              "the prior is used in full while the fitted bones differ from the source's by at most this (relative), and not at all beyond 1.6 x this");
+    s.number("offset_cap", [](O& o) -> double& { return o.fit.offset_cap; }, 0, 100,
+             "outside the source's rig family, a joint's offset from its skeleton point is at most this x the skeleton's radius there (0 = off)");
     s.integer("marker_reach", [](O& o) -> int& { return o.fit.marker_reach; }, 0, 100,
               "markers also move joints up to this many bones away");
     s.number("marker_anchor", [](O& o) -> double& { return o.fit.marker_anchor; }, 0, 1,

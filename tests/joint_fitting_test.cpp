@@ -270,12 +270,29 @@ TEST(JointFitting, BarbarianSkeletonInKnight) {
 // (same figures natively and in wasm). Thirty-third session: the touching-legs split (step 4b) also
 // runs when the source has a third low limb end (the robot's left hand hangs at 0.07 of its
 // height): RobotExpressive → CesiumMan 7.6 → 5.4 %.
+// Fortieth session: offsets capped at 2.5 source radii outside the source's rig family. The robot's
+// shoulders lie 4.6–5.4 radii from its hanging arms' path; carried in fixed axes onto CesiumMan's
+// spread arms they landed in his head (UpperArm.L 0.165 of the height off): 5.4 → 3.7 %.
 TEST(JointFitting, RobotSkeletonInCesiumMan) {
   const JfRun r = jf_fit_characters("anim/RobotExpressive/RobotExpressive.glb", "anim/CesiumMan/CesiumMan.glb", kRobotToCesium);
   jf_report(this, "RobotExpressive joints in CesiumMan (10 key joints)", r);
   EXPECT_EQ(r.outside, 0);
   EXPECT_EQ(r.error.count, 10);
-  EXPECT_LE(r.error.mean, 0.058);  // issue 14 asks 0.03
+  EXPECT_LE(r.error.mean, 0.04);  // issue 14 asks 0.03
+  // Without the cap the shoulders go back into the head.
+  const JfCharacter s = jf_character("anim/RobotExpressive/RobotExpressive.glb"), t = jf_character("anim/CesiumMan/CesiumMan.glb");
+  mm::JointFitOptions o;
+  o.target_up = 1, o.target_front = 2, o.offset_cap = 0;
+  const mm::JointFitResult off = mm::fit_joints(s.c.V_rest, s.c.F, s.joints, t.c.V_rest, t.c.F, {}, o);
+  ASSERT_TRUE(off.status.ok()) << off.status.message;
+  const JfError e = jf_joint_error(off.joints, t.joints, jf_extent(t.c.V_rest, 1), kRobotToCesium);
+  jf_print("RobotExpressive joints in CesiumMan, offsets not capped", e, off);
+  EXPECT_GT(e.mean, r.error.mean + 0.01);
+  const int shoulder = off.joints.find("UpperArm.L"), head = off.joints.find("Head");
+  ASSERT_GE(shoulder, 0);
+  ASSERT_GE(head, 0);
+  EXPECT_GT(off.joints.P(shoulder, 1), off.joints.P(head, 1));  // above the head joint
+  EXPECT_LT(r.fit.joints.P(r.fit.joints.find("UpperArm.L"), 1), r.fit.joints.P(r.fit.joints.find("Head"), 1));
 }
 
 // The refusal of a source limb the target lacks asks for markers; markers on that limb's joints, or
@@ -431,6 +448,20 @@ TEST(JointFitting, SameJointsOnAnyThreadCount) {
       const mm::JointFitResult r = mm::fit_joints(s.c.V_rest, s.c.F, s.joints, fine.V, fine.F, {}, {}, cancel);
       EXPECT_EQ(r.status.code, mm::StatusCode::Cancelled) << threads << " threads, cancel at report " << after << ": " << r.status.message;
     }
+  // A many-part mesh of ≥ 32k triangles: its parts' solids are built on two threads (the robot,
+  // 63 parts, split 1 → 16).
+  const JfCharacter robot = jf_character("anim/RobotExpressive/RobotExpressive.glb");
+  const mm::Mesh robot16 = mm::midpoint_subdivide(mm::midpoint_subdivide(mm::Mesh{robot.c.V_rest, robot.c.F}));
+  ASSERT_GE(robot16.F.rows(), 32768);
+  mm::CurveSkeleton sk[2];
+  for (int k = 0; k < 2; ++k) {
+    mm::set_max_threads(k + 1);
+    sk[k] = mm::curve_skeleton(robot16.V, robot16.F);
+    ASSERT_TRUE(sk[k].status.ok()) << sk[k].status.message;
+  }
+  EXPECT_TRUE(sk[0].nodes == sk[1].nodes);
+  EXPECT_TRUE(sk[0].radius == sk[1].radius);
+  EXPECT_TRUE(sk[0].volume.solid == sk[1].volume.solid);
   mm::set_max_threads(0);
   for (int k = 1; k < 3; ++k) {
     EXPECT_EQ(J[k].names, J[0].names);

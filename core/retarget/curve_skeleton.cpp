@@ -139,9 +139,9 @@ std::vector<uint8_t> cs_dilate(const CsGrid& g, const std::vector<uint8_t>& mask
     const int n = dims[axis];
     const size_t st = stride[axis];
     const int o1 = (axis + 1) % 3, o2 = (axis + 2) % 3;
-    // Lines are independent: blocks of planes on the task threads (≥ 64k cells a block).
+    // Lines are independent: blocks of planes on the task threads (≥ 256k cells a block).
     const long plane = long(dims[o1]) * n;
-    parallel_blocks(dims[o2], std::max(1L, 65536 / std::max(1L, plane)), [&](long v0, long v1) {
+    parallel_blocks(dims[o2], std::max(1L, 262144 / std::max(1L, plane)), [&](long v0, long v1) {
       for (long v = v0; v < v1; ++v)
         for (int u = 0; u < dims[o1]; ++u) {
           const size_t base = size_t(u) * stride[o1] + size_t(v) * stride[o2];
@@ -347,7 +347,7 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
     // With a second thread, the second half of the triangles is marked on a grid of its own by a
     // pool task, then the two grids are joined (a cell is marked by either: the same grid).
     const int nf = int(F.rows());
-    const int split = MM_HAS_THREADS && max_threads() > 1 && nf >= 8192 ? nf / 2 : nf;
+    const int split = MM_HAS_THREADS && max_threads() > 1 && nf >= 32768 ? nf / 2 : nf;
     std::vector<uint8_t> surf2;
     std::atomic<bool> stop{false};
     Task second;
@@ -472,7 +472,7 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
       // With a second thread, the parts holding the second half of the triangles are done on a pool
       // task into a mask of its own, joined after (the bits are the same either way).
       int split = np;
-      if (MM_HAS_THREADS && max_threads() > 1 && F.rows() >= 8192) {
+      if (MM_HAS_THREADS && max_threads() > 1 && F.rows() >= 32768) {
         long acc = 0;
         for (split = 0; split < np && 2 * acc < F.rows(); ++split) acc += long(part_faces[split].size());
       }

@@ -1003,6 +1003,13 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
       b.insert(at, {s, x});
     }
   }
+  // Each joint's target skeleton point and offset first (placed below).
+  struct Carried {
+    bool ok = false;
+    Eigen::Vector3d qt, off;  // target skeleton point; offset in the target's axes, scaled
+    double far = 1;           // the offset's length in source radii at its skeleton point
+  };
+  std::vector<Carried> carried(source_joints.size());
   for (int j : used) {
     const Eigen::Vector3d pj = source_joints.P.row(j).transpose();
     int e;
@@ -1031,7 +1038,35 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     const Eigen::Vector3d qt = sum / n;
     const double rt = rsum / n;
     const double scale = std::clamp(rq > 0 ? rt / rq : 1.0, 0.25, 4.0);
-    const Eigen::Vector3d off = R.transpose() * (pj - q) * scale;
+    carried[j] = {true, qt, R.transpose() * (pj - q) * scale, rq > 0 ? (pj - q).norm() / rq : 1.0};
+  }
+  // Offsets far from the skeleton. A joint several radii from its skeleton point (a robot's
+  // shoulder: 5.4 radii from its hanging arm's path) is not described by that point: carried in
+  // fixed axes onto a limb posed otherwise (CesiumMan's spread arm), its offset leads anywhere (into
+  // his head, which is inside the mesh, so step 6 keeps it). Such offsets are capped at
+  // offset_cap radii, unless the target is of the source's rig family — the fitted skeleton then
+  // agrees with the source's bones as in step 5c (Σ|d − b| / Σ|b| ≤ 1.6 × skeleton_prior_agreement
+  // over bones between placed joints), where offsets carry over as they are (self fits stay exact;
+  // KayKit's IK helpers lie 9.5 radii off the feet).
+  if (opt.offset_cap > 0) {
+    double dev = 0, len = 0;
+    for (int j : used) {
+      if (!carried[j].ok) continue;
+      int a = static_cast<int>(source_joints.parent.size()) == source_joints.size() ? source_joints.parent[j] : -1;
+      while (a >= 0 && !carried[a].ok) a = source_joints.parent[a];
+      if (a < 0) continue;
+      const Eigen::Vector3d b = R.transpose() * ((ft.H / fs.H) * (source_joints.P.row(j) - source_joints.P.row(a)).transpose());
+      const Eigen::Vector3d d = (carried[j].qt + carried[j].off) - (carried[a].qt + carried[a].off);
+      dev += (d - b).norm();
+      len += b.norm();
+    }
+    if (len > 0 && dev > 1.6 * opt.skeleton_prior_agreement * len)
+      for (int j : used)
+        if (carried[j].ok && carried[j].far > opt.offset_cap) carried[j].off *= opt.offset_cap / carried[j].far;
+  }
+  for (int j : used) {
+    if (!carried[j].ok) continue;
+    const Eigen::Vector3d qt = carried[j].qt, off = carried[j].off;
     // 6. Pull toward the skeleton point until inside.
     Eigen::Vector3d p = qt + off;
     for (int it = 0; it < 6 && !inside_t(p); ++it) p = qt + off * std::pow(0.5, it + 1);

@@ -92,6 +92,8 @@ struct JointFitOptions {
   double skeleton_prior = 2;       // step 5c: weight of the source's bones (scaled into the target) against the fit (0 = off)
   double skeleton_prior_agreement = 0.15;  // ... full while the fitted bones differ from those by ≤ this (Σ|d − b| / Σ|b|),
                                    // fading to 0 at 1.6 × this (a target of the source's rig family)
+  double offset_cap = 2.5;         // step 5: unless the target is of the source's rig family (the skeleton prior's gate),
+                                  // a joint's offset from its skeleton point is at most this × the source radius there (0 = off)
   int marker_reach = 3;           // markers move unpinned joints up to this many bones away (0 = only pin)
   double marker_anchor = 0.1;     // step 5: a marker within this × height of a target path between matched ends
                                   // anchors the proportions along it (0 = off)
