@@ -157,6 +157,53 @@ TEST(Tasks, WaitRethrowsTheWorksExceptionAndTheDestructorWaits) {
   EXPECT_TRUE(held.wait_for(std::chrono::milliseconds(5000)));
 }
 
+TEST(Tasks, AStoppableTaskIsStoppedByItsOwnersEarlyReturn) {
+  // Work that runs until it is told to stop (bounded at 10 s so a broken stop fails, not hangs).
+  auto until_stopped = [](std::atomic<int>* reports, std::atomic<bool>* stopped) {
+    return [reports, stopped](const Progress& watch) {
+      const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      while (std::chrono::steady_clock::now() < end) {
+        if (!watch.update("spin", 0.5)) {
+          *stopped = true;
+          return;
+        }
+        ++*reports;
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
+    };
+  };
+  for (int threads : {1, 2}) {
+    ThreadCount count(threads);
+    std::atomic<int> reports{0}, recorded{0};
+    std::atomic<bool> stopped{false};
+    const auto t0 = std::chrono::steady_clock::now();
+    {
+      StoppableTask task(until_stopped(&reports, &stopped), [&](const std::string& stage, double f) {
+        EXPECT_EQ(stage, "spin");
+        EXPECT_EQ(f, 0.5);
+        ++recorded;
+        return false;  // the recorder cannot stop the work: only the owner can
+      });
+      if (threads_supported() && threads > 1)
+        for (int i = 0; i < 10000 && reports.load() < 3; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      EXPECT_FALSE(task.stop_requested());
+    }  // an early return: the destructor stops the work, then waits for it
+    EXPECT_TRUE(stopped.load()) << threads << " threads";
+    EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5));
+    if (threads_supported() && threads > 1) EXPECT_GE(reports.load(), 3);
+    else EXPECT_EQ(reports.load(), 0);  // run in the destructor, already stopped
+    EXPECT_EQ(recorded.load(), reports.load() + 1);  // every report, the refused one too
+    // Assigning over a running task stops the old one; wait() lets the new one finish.
+    std::atomic<int> reports2{0};
+    std::atomic<bool> stopped2{false}, ran{false};
+    StoppableTask a(until_stopped(&reports2, &stopped2));
+    a = StoppableTask([&ran](const Progress& watch) { ran = watch.update("once", 1.0); });
+    EXPECT_TRUE(stopped2.load());
+    a.wait();
+    EXPECT_TRUE(ran.load());
+  }
+}
+
 TEST(Tasks, TwoHalvesGiveTheSameSumAsOneLoop) {
   std::vector<double> x(100000);
   for (size_t i = 0; i < x.size(); ++i) x[i] = 1.0 / static_cast<double>(i + 1);

@@ -203,6 +203,25 @@ void Task::finish_quietly() noexcept {
   }
 }
 
+StoppableTask::StoppableTask(std::function<void(const Progress&)> work, Progress::Callback record)
+    : stop_(std::make_shared<std::atomic<bool>>(false)) {
+  const std::shared_ptr<std::atomic<bool>> stop = stop_;
+  const Progress watch([stop, record = std::move(record)](const std::string& stage, double f) {
+    if (record) record(stage, f);
+    return !stop->load();
+  });
+  task_ = Task([watch, work = std::move(work)] { work(watch); });
+}
+
+StoppableTask& StoppableTask::operator=(StoppableTask&& other) noexcept {
+  if (this != &other) {
+    request_stop();
+    task_ = std::move(other.task_);  // waits for the old work
+    stop_ = std::move(other.stop_);
+  }
+  return *this;
+}
+
 void parallel_blocks(long n, long min_block, const std::function<void(long, long)>& fn) {
   if (n <= 0) return;
   const long most = std::max(1L, n / std::max(1L, min_block));

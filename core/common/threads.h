@@ -20,9 +20,12 @@
 // within one op and the next start would wait forever.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <memory>
+
+#include "common/progress.h"
 
 #if !defined(__EMSCRIPTEN__) || defined(__EMSCRIPTEN_PTHREADS__)
 #define MM_HAS_THREADS 1
@@ -72,6 +75,34 @@ class Task {
  private:
   void finish_quietly() noexcept;
   std::shared_ptr<State> state_;
+};
+
+// A Task whose owner may return before it needs the result (an error, a cancel): the work gets a
+// Progress `watch` whose update() returns false once the owner asked it to stop, and the
+// destructor asks it to stop before it waits, so an early return never waits for work whose
+// result it drops. `record`, if given, is called with every report of the work (from the thread
+// running it: it must be thread-safe); the watch never calls the owner's own sink, which in wasm
+// lives on the calling thread alone.
+class StoppableTask {
+ public:
+  StoppableTask() = default;
+  explicit StoppableTask(std::function<void(const Progress& watch)> work, Progress::Callback record = {});
+  StoppableTask(StoppableTask&&) noexcept = default;
+  StoppableTask& operator=(StoppableTask&& other) noexcept;
+  ~StoppableTask() { request_stop(); }  // then task_'s destructor waits
+
+  bool valid() const { return task_.valid(); }
+  // The work's watch returns false from its next update on.
+  void request_stop() {
+    if (stop_) stop_->store(true);
+  }
+  bool stop_requested() const { return stop_ && stop_->load(); }
+  void wait() { task_.wait(); }
+  bool wait_for(std::chrono::milliseconds timeout) { return task_.wait_for(timeout); }
+
+ private:
+  std::shared_ptr<std::atomic<bool>> stop_;
+  Task task_;  // after stop_: destroyed (waited for) first
 };
 
 // Splits [0, n) into up to min(max_threads(), kMaxPoolThreads + 1) contiguous blocks of at least

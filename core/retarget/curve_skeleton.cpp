@@ -3,7 +3,6 @@
 #include "common/threads.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -349,13 +348,12 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
     const int nf = int(F.rows());
     const int split = MM_HAS_THREADS && max_threads() > 1 && nf >= 32768 ? nf / 2 : nf;
     std::vector<uint8_t> surf2;
-    std::atomic<bool> stop{false};
-    Task second;
+    StoppableTask second;  // after what it writes: an early return stops and waits for it
     if (split < nf) {
       surf2.assign(g.size(), 0);
-      second = Task([&, split, nf] {
+      second = StoppableTask([&, split, nf](const Progress& watch) {
         std::vector<int> chunk;
-        for (int f0 = split; f0 < nf && !stop.load(); f0 += 4096) {
+        for (int f0 = split; f0 < nf && watch.update("skeleton: voxels", 0); f0 += 4096) {
           chunk.clear();
           for (int f = f0; f < std::min(f0 + 4096, nf); ++f) chunk.push_back(f);
           cs_rasterize(V, F, chunk, glo, h, no_offset, g, &surf2);
@@ -364,10 +362,8 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
     }
     std::vector<int> chunk;
     for (int f0 = 0; f0 < split; f0 += 4096) {
-      if (!progress.update("skeleton: voxels", 0.3 * f0 / split)) {
-        stop.store(true);
+      if (!progress.update("skeleton: voxels", 0.3 * f0 / split))
         return fail(StatusCode::Cancelled, "cancelled during skeleton: voxels");
-      }
       chunk.clear();
       for (int f = f0; f < std::min(f0 + 4096, split); ++f) chunk.push_back(f);
       cs_rasterize(V, F, chunk, glo, h, no_offset, g, &surf);
@@ -477,19 +473,16 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
         for (split = 0; split < np && 2 * acc < F.rows(); ++split) acc += long(part_faces[split].size());
       }
       std::vector<uint64_t> mask2;
-      std::atomic<bool> stop{false};
-      Task second;
+      StoppableTask second;  // after what it writes: an early return stops and waits for it
       if (split < np) {
         mask2.assign(g.size(), 0);
-        second = Task([&, split] {
-          for (int p = split; p < np && !stop.load(); ++p) add_part(p, &mask2);
+        second = StoppableTask([&, split](const Progress& watch) {
+          for (int p = split; p < np && watch.update("skeleton: parts", 0); ++p) add_part(p, &mask2);
         });
       }
       for (int p = 0; p < split; ++p) {
-        if (!progress.update("skeleton: parts", 0.4 + 0.05 * p / np)) {
-          stop.store(true);
+        if (!progress.update("skeleton: parts", 0.4 + 0.05 * p / np))
           return fail(StatusCode::Cancelled, "cancelled during skeleton: parts");
-        }
         add_part(p, &mask);
       }
       if (second.valid()) {

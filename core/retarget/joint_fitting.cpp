@@ -1,7 +1,6 @@
 #include "retarget/joint_fitting.h"
 
 #include <algorithm>
-#include <atomic>
 #include <functional>
 #include <cmath>
 #include <cstdio>
@@ -610,6 +609,17 @@ struct JfInputs {
   const Progress& progress;
 };
 
+// How far fitted bones d are from the source's bones b in the target's frame, Σ|d − b| / Σ|b|
+// (0 without bones): step 5c's measure of whether the target is of the source's rig family.
+struct BoneAgreement {
+  double dev = 0, len = 0;
+  void add(const Eigen::Vector3d& d, const Eigen::Vector3d& b) {
+    dev += (d - b).norm();
+    len += b.norm();
+  }
+  double ratio() const { return len > 0 ? dev / len : 0; }
+};
+
 JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool source_is_curve, bool* lost_limbs,
                                    bool markers_lift_lost) {
   const Eigen::MatrixXd &Vs = in.Vs, &Vt = in.Vt;
@@ -1048,19 +1058,20 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
   // agrees with the source's bones as in step 5c (Σ|d − b| / Σ|b| ≤ 1.6 × skeleton_prior_agreement
   // over bones between placed joints), where offsets carry over as they are (self fits stay exact;
   // KayKit's IK helpers lie 9.5 radii off the feet).
+  // The source's bone (child c, parent p) carried into the target's frame by the global similarity.
+  auto source_bone = [&](int c, int p) -> Eigen::Vector3d {
+    return R.transpose() * ((ft.H / fs.H) * (source_joints.P.row(c) - source_joints.P.row(p)).transpose());
+  };
   if (opt.offset_cap > 0) {
-    double dev = 0, len = 0;
+    BoneAgreement agreement;
     for (int j : used) {
       if (!carried[j].ok) continue;
       int a = static_cast<int>(source_joints.parent.size()) == source_joints.size() ? source_joints.parent[j] : -1;
       while (a >= 0 && !carried[a].ok) a = source_joints.parent[a];
       if (a < 0) continue;
-      const Eigen::Vector3d b = R.transpose() * ((ft.H / fs.H) * (source_joints.P.row(j) - source_joints.P.row(a)).transpose());
-      const Eigen::Vector3d d = (carried[j].qt + carried[j].off) - (carried[a].qt + carried[a].off);
-      dev += (d - b).norm();
-      len += b.norm();
+      agreement.add((carried[j].qt + carried[j].off) - (carried[a].qt + carried[a].off), source_bone(j, a));
     }
-    if (len > 0 && dev > 1.6 * opt.skeleton_prior_agreement * len)
+    if (agreement.ratio() > 1.6 * opt.skeleton_prior_agreement)
       for (int j : used)
         if (carried[j].ok && carried[j].far > opt.offset_cap) carried[j].off *= opt.offset_cap / carried[j].far;
   }
@@ -1138,17 +1149,15 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     for (int j : used)
       if (out_index[j] >= 0) src_of[out_index[j]] = j;
     std::vector<std::pair<int, Eigen::Vector3d>> bones;  // (child k, source bone in target frame)
-    double dev = 0, len = 0;
+    BoneAgreement agreement;
     for (int k = 0; k < n; ++k) {
       const int q = out.parent[k];
       if (q < 0) continue;
-      const Eigen::Vector3d b =
-          R.transpose() * ((ft.H / fs.H) * (source_joints.P.row(src_of[k]) - source_joints.P.row(src_of[q])).transpose());
-      dev += ((out.P.row(k) - out.P.row(q)).transpose() - b).norm();
-      len += b.norm();
+      const Eigen::Vector3d b = source_bone(src_of[k], src_of[q]);
+      agreement.add((out.P.row(k) - out.P.row(q)).transpose(), b);
       bones.emplace_back(k, b);
     }
-    const double a = opt.skeleton_prior_agreement, rel = len > 0 ? dev / len : 0;
+    const double a = opt.skeleton_prior_agreement, rel = agreement.ratio();
     r.skeleton_agreement = rel;
     // Fits of one kind of character measure r 0.11–0.42 (above; human_woman at the grids where her
     // fit is good, 3.5–4.2 %: 0.37–0.42); her broken fits at unlucky grid resolutions 0.53–0.62
@@ -1268,17 +1277,10 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
   TriangleBvh bvh_s, bvh_t;
   {
     CurveSkeleton source_skeleton;  // the task's (r is copied by an early return while it may run)
-    std::atomic<bool> stop{false};
-    struct StopOnExit {
-      std::atomic<bool>& flag;
-      ~StopOnExit() { flag.store(true); }
-    };
-    Task source_task;  // declared after what it writes: an early return waits for it (destructor)
-    const StopOnExit stop_on_exit{stop};
+    StoppableTask source_task;  // declared after what it writes: an early return stops and waits for it
     const bool overlap = MM_HAS_THREADS && max_threads() > 1;
     if (overlap) {
-      const Progress watch([&stop](const std::string&, double) { return !stop.load(); });
-      source_task = Task([&source_skeleton, &bvh_s, &Vs, &Fs, &opt, watch] {
+      source_task = StoppableTask([&source_skeleton, &bvh_s, &Vs, &Fs, &opt](const Progress& watch) {
         source_skeleton = curve_skeleton(Vs, Fs, opt.skeleton, watch);
         if (source_skeleton.status.ok()) bvh_s.build(Vs, Fs);
       });

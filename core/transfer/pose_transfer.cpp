@@ -1,7 +1,6 @@
 #include "transfer/pose_transfer.h"
 #include "transfer/flip_repair.h"
 
-#include <atomic>
 #include <chrono>
 #include <mutex>
 #include <numeric>
@@ -203,8 +202,7 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
     r.ms_mvc = elapsed_ms(t);
     return r;
   };
-  // Declared before the future: its destructor waits for the thread, which uses these.
-  std::atomic<bool> stop_cage{false};
+  // Declared before the task: its destructor waits for the thread, which uses these.
   struct CageReport {
     std::mutex mutex;
     bool recorded = false;
@@ -213,27 +211,24 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
   } report;
   const Progress cage_range = progress.sub(0.4, 0.85);
   CageStage cage_result;
-  Task cage_task;  // declared after what it writes: an early return below waits for it first
+  // Declared after what it writes: whatever returns early below stops the cage task and waits for it.
+  StoppableTask cage_task;
 #if MM_HAS_THREADS
   if (opt.method == TransferMethod::Yin && max_threads() > 1) {
-    const Progress watch([&](const std::string& stage, double f) {
+    const auto record = [&report](const std::string& stage, double f) {
       std::lock_guard<std::mutex> lock(report.mutex);
-      f = std::max(f, report.fraction);
       report.stage = stage;
-      report.fraction = f;
+      report.fraction = std::max(f, report.fraction);
       report.recorded = true;
-      return !stop_cage.load();
-    });
-    cage_task = Task([&cage_result, cage_stage, watch, &opt] {
-      cage_result = cage_stage(opt.cage, watch.sub(0.0, 0.45), watch.sub(0.45, 1.0));
-    });
+      return true;
+    };
+    cage_task = StoppableTask(
+        [&cage_result, cage_stage, &opt](const Progress& watch) {
+          cage_result = cage_stage(opt.cage, watch.sub(0.0, 0.45), watch.sub(0.45, 1.0));
+        },
+        record);
   }
 #endif
-  // Whatever returns early below stops the cage task first (the task's destructor then waits).
-  struct StopOnExit {
-    std::atomic<bool>& flag;
-    ~StopOnExit() { flag.store(true); }
-  } stop_on_exit{stop_cage};
 
   // 2. Eigenbases.
   auto t0 = clock::now();
@@ -316,7 +311,7 @@ PoseTransferResult pose_transfer(const Mesh& reference, const Mesh& source, cons
           stage = report.stage;
           fraction = report.fraction;
         }
-        if (!stop_cage.load() && !cage_range.update(stage, fraction)) stop_cage.store(true);
+        if (!cage_task.stop_requested() && !cage_range.update(stage, fraction)) cage_task.request_stop();
       }
     }
     CageStage cs = cage_threaded ? std::move(cage_result)
