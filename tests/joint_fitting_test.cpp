@@ -273,14 +273,25 @@ TEST(JointFitting, BarbarianSkeletonInKnight) {
 // Fortieth session: offsets capped at 2.5 source radii outside the source's rig family. The robot's
 // shoulders lie 4.6–5.4 radii from its hanging arms' path; carried in fixed axes onto CesiumMan's
 // spread arms they landed in his head (UpperArm.L 0.165 of the height off): 5.4 → 3.7 %.
+// Forty-first session: a joint its offset carries outside the target is pulled toward the nearest
+// point of the target's skeleton before the old pull toward its own skeleton point. The robot's
+// right hip joint left CesiumMan's thigh sideways; halved toward its skeleton point (on the leg
+// path, lower) it sank 6.3 % of the height: UpperLeg.R 7.1 → 4.1 %, all 3.7 → 3.4 %.
 TEST(JointFitting, RobotSkeletonInCesiumMan) {
   const JfRun r = jf_fit_characters("anim/RobotExpressive/RobotExpressive.glb", "anim/CesiumMan/CesiumMan.glb", kRobotToCesium);
   jf_report(this, "RobotExpressive joints in CesiumMan (10 key joints)", r);
   EXPECT_EQ(r.outside, 0);
   EXPECT_EQ(r.error.count, 10);
-  EXPECT_LE(r.error.mean, 0.04);  // issue 14 asks 0.03
+  EXPECT_LE(r.error.mean, 0.036);  // issue 14 asks 0.03
   // Without the cap the shoulders go back into the head.
   const JfCharacter s = jf_character("anim/RobotExpressive/RobotExpressive.glb"), t = jf_character("anim/CesiumMan/CesiumMan.glb");
+  // The right hip joint stays at the height of CesiumMan's (it sank 0.063 of the height when
+  // pulled inside toward its own skeleton point).
+  const double height = jf_extent(t.c.V_rest, 1);
+  const int hip_fit = r.fit.joints.find("UpperLeg.R"), hip_true = t.joints.find("leg_joint_R_1");
+  ASSERT_GE(hip_fit, 0);
+  ASSERT_GE(hip_true, 0);
+  EXPECT_LT(std::abs(r.fit.joints.P(hip_fit, 1) - t.joints.P(hip_true, 1)), 0.03 * height);
   mm::JointFitOptions o;
   o.target_up = 1, o.target_front = 2, o.offset_cap = 0;
   const mm::JointFitResult off = mm::fit_joints(s.c.V_rest, s.c.F, s.joints, t.c.V_rest, t.c.F, {}, o);
