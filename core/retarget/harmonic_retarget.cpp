@@ -397,19 +397,18 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
   {
     const Eigen::MatrixXd& VSinv = src_map_.coefficient_map();
     KsJ_ = Ks_joints_ * VSinv;
-    Ga_ = synth_.solution_operator(term_affine_, Ds_desc * VSinv);
-    gp_ = synth_.solution_operator(term_position_);
-    KtGa_ = Kt_joints_ * Ga_;
-    Ktgp_ = Kt_joints_ * gp_;
-    if (term_bone_ >= 0) {
-      Gb_ = synth_.solution_operator(term_bone_);
-      KtGb_ = Kt_joints_ * Gb_;
-    } else {
-      Gb_.resize(U.rows(), 0);
-      KtGb_.resize(Kt_joints_.rows(), 0);
-    }
-    if (!Ga_.allFinite() || !gp_.allFinite() || !Gb_.allFinite())
+    const Eigen::MatrixXd Ga = synth_.solution_operator(term_affine_, Ds_desc * VSinv);
+    const Eigen::MatrixXd gp = synth_.solution_operator(term_position_);
+    KtGa_ = Kt_joints_ * Ga;
+    Ktgp_ = Kt_joints_ * gp;
+    Eigen::MatrixXd Gb(U.rows(), 0);
+    if (term_bone_ >= 0) Gb = synth_.solution_operator(term_bone_);
+    KtGb_ = Kt_joints_ * Gb;
+    if (!Ga.allFinite() || !gp.allFinite() || !Gb.allFinite())
       return Status::error(StatusCode::NumericalError, "synthesis operators are not finite");
+    // Stacked and transposed for the per-frame product (transposed_times_n3).
+    GT_.resize(Ga.cols() + 1 + Gb.cols(), U.rows());
+    GT_ << Ga.transpose(), gp.transpose(), Gb.transpose();
   }
   if (graph_on_) {
     // E_spatial (Eq. 11): B = (s·L·Pa(frame) + R·(L Va − s L Pa_rest)) / ℓ, linear in Pa(frame)
@@ -687,8 +686,9 @@ RetargetFrame HarmonicRetargeter::retarget(const Eigen::MatrixXd& V_source) cons
     }
     Jt_now = Jt_fixed + KtGb_ * (dirs - base_dirs);
   }
-  Eigen::MatrixXd Wt = Ga_ * Ys + gp_ * p_map;
-  if (nb > 0) Wt.noalias() += Gb_ * (dirs - base_dirs);
+  Eigen::MatrixXd Z(GT_.rows(), 3);  // [Ys; p; d̂ − base]: Wt = [Ga gp Gb] Z
+  Z << Ys, p_map, dirs - base_dirs;
+  Eigen::MatrixXd Wt = transposed_times_n3(GT_, Z);
   if (graph_on_) Wt += W_graph;
   if (!Wt.allFinite()) {
     out.status = Status::error(StatusCode::NumericalError, "synthesized coefficients are not finite");

@@ -239,7 +239,7 @@ class HarmonicRetargeter {
   Eigen::MatrixXd Kt_joints_;           // #used by N_a(target)
   // Per-frame operators (see precompute): r = rank of the source's As.
   Eigen::MatrixXd KsJ_;                 // #used by r: source joints from Ys
-  Eigen::MatrixXd Ga_, gp_, Gb_;        // N_a(target) by r, 1, #bones
+  Eigen::MatrixXd GT_;                  // [Ga gp Gb]ᵀ: r + 1 + #bones by N_a(target)
   Eigen::MatrixXd KtGa_, Ktgp_, KtGb_;  // the same mapped to the target joints
   Eigen::MatrixXd KtT_all_;             // N_a(target) by #V_target: Ktᵀ (see transposed_times_n3)
   Eigen::MatrixXd Js_rest_, Jt_rest_;   // used joints, working frames

@@ -25,7 +25,7 @@ Eigen::MatrixXd mfs_gradient(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Q)
 Eigen::MatrixXd mfs_hessian(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Q);
 
 // Mtᵀ B for Mt (k by n) and B (k by 3): the per-frame products of the retargeting (V = Kt Wt,
-// Uᵀ bs) with the big operand stored transposed, so that each output row reads one contiguous
+// Uᵀ bs, Wt = [Ga gp Gb] [Ys; p; d̂]) with the big operand stored transposed, so that each output row reads one contiguous
 // column. A plain loop with a fixed summation order: for three right-hand columns it is faster
 // than a general matrix product (no packing of the big operand on every call), natively and in
 // WebAssembly without SIMD, and both platforms sum in the same order.
