@@ -98,28 +98,21 @@ struct JfTree {
   Eigen::Vector3d pos(int i) const { return s->nodes.row(i).transpose(); }
 };
 
-// The closest point to p on the tree's edges (node u to its parent), of those listed in `edges`
-// or all when it is null; its edge and parameter from u in *edge, *t (-1, 0 and the root's
-// position when there is none).
-Eigen::Vector3d jf_closest_on_edges(const JfTree& tree, const Eigen::Vector3d& p, const std::vector<int>* edges,
-                                    int* edge = nullptr, double* t = nullptr) {
+// The closest point to p on the tree's edges listed in `edges` (node u to its parent); its edge
+// and parameter from u in *edge, *t (-1, 0 and the root's position when there is none).
+Eigen::Vector3d jf_closest_on_edges(const JfTree& tree, const Eigen::Vector3d& p, const std::vector<int>& edges,
+                                    int* edge, double* t) {
   double best = std::numeric_limits<double>::infinity();
   Eigen::Vector3d c = tree.pos(tree.s->root);
-  int be = -1;
-  double bt = 0;
-  const int n = edges ? static_cast<int>(edges->size()) : tree.s->size();
-  for (int i = 0; i < n; ++i) {
-    const int u = edges ? (*edges)[i] : i;
-    if (tree.s->parent[u] < 0) continue;
+  *edge = -1, *t = 0;
+  for (int u : edges) {
     const Eigen::Vector3d a = tree.pos(u), b = tree.pos(tree.s->parent[u]);
     const double l2 = (b - a).squaredNorm();
     const double x = l2 > 0 ? std::clamp((p - a).dot(b - a) / l2, 0.0, 1.0) : 0.0;
     const Eigen::Vector3d y = a + x * (b - a);
     const double d = (p - y).squaredNorm();
-    if (d < best) best = d, c = y, be = u, bt = x;
+    if (d < best) best = d, c = y, *edge = u, *t = x;
   }
-  if (edge) *edge = be;
-  if (t) *t = bt;
   return c;
 }
 
@@ -795,7 +788,7 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
         for (int x = i; x >= 0 && leaves_below[x] == 1; x = SS.parent[x]) only_leaf[x] = i;
   }
   auto closest_on_edges = [&](const Eigen::Vector3d& p, const std::vector<int>& edges, int* edge, double* t) {
-    return jf_closest_on_edges(st, p, &edges, edge, t);
+    return jf_closest_on_edges(st, p, edges, edge, t);
   };
   std::vector<int> all_edges;
   for (int i = 0; i < ns; ++i)
@@ -984,16 +977,31 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
       closest_on_edges(source_joints.P.row(k).transpose(), matched_edges, &a.e, &a.t);
       if (a.e >= 0) anchors.push_back(a);
     }
-  auto arc_on_target = [&](const JfPath& pt, const Eigen::Vector3d& m) {
-    double best = std::numeric_limits<double>::infinity(), arc = -1;
+  // The closest point to m on a target path: its distance, arc length and position.
+  struct OnPath {
+    double distance = std::numeric_limits<double>::infinity(), arc = -1;
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  };
+  // Only the part of the path between arc lengths lo and hi when given.
+  auto closest_on_target_path = [&](const JfPath& pt, const Eigen::Vector3d& m, double lo = -1.0,
+                                    double hi = std::numeric_limits<double>::infinity()) {
+    OnPath best;
     for (size_t k = 0; k + 1 < pt.nodes.size(); ++k) {
+      const double a0 = pt.arc[k], a1 = pt.arc[k + 1];
+      if (a1 < lo || a0 > hi) continue;
+      const double u0 = a1 > a0 ? std::max(0.0, (lo - a0) / (a1 - a0)) : 0.0;
+      const double u1 = a1 > a0 ? std::min(1.0, (hi - a0) / (a1 - a0)) : 1.0;
       const Eigen::Vector3d x = tt.pos(pt.nodes[k]), y = tt.pos(pt.nodes[k + 1]);
       const double l2 = (y - x).squaredNorm();
-      const double u = l2 > 0 ? std::clamp((m - x).dot(y - x) / l2, 0.0, 1.0) : 0.0;
+      const double u = l2 > 0 ? std::clamp((m - x).dot(y - x) / l2, u0, std::max(u0, u1)) : 0.0;
       const double d = (m - x - u * (y - x)).norm();
-      if (d < best) best = d, arc = pt.arc[k] + u * (pt.arc[k + 1] - pt.arc[k]);
+      if (d < best.distance) best = {d, pt.arc[k] + u * (pt.arc[k + 1] - pt.arc[k]), x + u * (y - x)};
     }
-    return best <= opt.marker_anchor * ft.H ? arc : -1.0;  // ft.H: the target's height
+    return best;
+  };
+  auto arc_on_target = [&](const JfPath& pt, const Eigen::Vector3d& m) {
+    const OnPath c = closest_on_target_path(pt, m);
+    return c.distance <= opt.marker_anchor * ft.H ? c.arc : -1.0;  // ft.H: the target's height
   };
   // Per pair of matched ends: (source arc, target arc) of its branch points and marker anchors, by
   // source arc, target arcs increasing (an anchor out of order with them is left out).
@@ -1032,6 +1040,11 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     bool ok = false;
     Eigen::Vector3d qt, off;  // target skeleton point; offset in the target's axes, scaled
     double far = 1;           // the offset's length in source radii at its skeleton point
+    struct Span {
+      int pair;
+      double lo, hi;
+    };
+    std::vector<Span> spans;  // the stretches of matched target paths (between branch points) qt was taken from
   };
   std::vector<Carried> carried(source_joints.size());
   for (int j : used) {
@@ -1057,12 +1070,16 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
       double rx;
       jf_point_at(tt, pp.pt, lo + tau * (hi - lo), &x, &rx);
       sum += x, rsum += rx, ++n;
+      carried[j].spans.push_back({static_cast<int>(ip), lo, hi});
     }
     if (n == 0) continue;  // cannot happen: e lies on some matched path
     const Eigen::Vector3d qt = sum / n;
     const double rt = rsum / n;
     const double scale = std::clamp(rq > 0 ? rt / rq : 1.0, 0.25, 4.0);
-    carried[j] = {true, qt, R.transpose() * (pj - q) * scale, rq > 0 ? (pj - q).norm() / rq : 1.0};
+    carried[j].ok = true;
+    carried[j].qt = qt;
+    carried[j].off = R.transpose() * (pj - q) * scale;
+    carried[j].far = rq > 0 ? (pj - q).norm() / rq : 1.0;
   }
   // Offsets far from the skeleton. A joint several radii from its skeleton point (a robot's
   // shoulder: 5.4 radii from its hanging arm's path) is not described by that point: carried in
@@ -1095,11 +1112,18 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     // 6. Pull toward the skeleton point until inside.
     Eigen::Vector3d p = qt + off;
     if (!inside_t(p)) {
-      // Outside: pulled toward the nearest point of the target's skeleton first, which keeps the
-      // joint at the height its offset gave it (the robot's hip joint, carried out of CesiumMan's
-      // thigh: 7.1 → 4.1 % of the height), then toward qt as before.
-      const Eigen::Vector3d c = jf_closest_on_edges(tt, p, nullptr), p0 = p;
-      for (int it = 0; it < 6 && !inside_t(p); ++it) p = c + (p0 - c) * std::pow(0.5, it + 1);
+      // Outside: pulled toward the nearest point of the stretch of skeleton (between branch
+      // points) qt was taken from first, which keeps the joint at the height its offset gave it
+      // (the robot's hip joint, carried out of CesiumMan's thigh: 7.1 → 4.1 % of the height), then
+      // toward qt as before. (The nearest point of the whole skeleton can be another part's: the
+      // robot's Shoulder.L went into CesiumMan's neck.)
+      OnPath c;
+      for (const Carried::Span& sp : carried[j].spans) {
+        const OnPath x = closest_on_target_path(pairs[sp.pair].pt, p, std::min(sp.lo, sp.hi), std::max(sp.lo, sp.hi));
+        if (x.distance < c.distance) c = x;
+      }
+      const Eigen::Vector3d p0 = p;
+      for (int it = 0; it < 6 && !inside_t(p) && c.arc >= 0; ++it) p = c.point + (p0 - c.point) * std::pow(0.5, it + 1);
     }
     for (int it = 0; it < 6 && !inside_t(p); ++it) p = qt + off * std::pow(0.5, it + 1);
     if (!inside_t(p)) p = qt;
