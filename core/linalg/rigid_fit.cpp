@@ -9,16 +9,16 @@ namespace mm {
 
 namespace rigid_fit_detail {
 
-// The fit from centred (and, when weighted, √w-scaled) rows P0, Q0 and the centroids.
-RigidFit rigid_fit_centred(const Eigen::MatrixXd& P0, const Eigen::MatrixXd& Q0, const Eigen::RowVector3d& pc,
-                           const Eigen::RowVector3d& qc, const RigidFitOptions& opt) {
+// The fit from the moments of centred (and, when weighted, √w-scaled) rows p̃, q̃:
+// C = Σ q̃ p̃ᵀ, p2 = Σ |p̃|², q2 = Σ |q̃|², and the centroids.
+RigidFit rigid_fit_from_moments(const Eigen::Matrix3d& C0, double p2, double q2, long rows,
+                                const Eigen::RowVector3d& pc, const Eigen::RowVector3d& qc, const RigidFitOptions& opt) {
   RigidFit fit;
-  const double p2 = P0.squaredNorm(), q2 = Q0.squaredNorm();
   fit.target_spread2 = q2;
   bool optimal = false;  // R is the unconstrained optimum (closed-form s and residual apply)
   double tr = 0;         // tr(ΣD)
-  if (P0.rows() >= 3) {
-    Eigen::Matrix3d C = Q0.transpose() * P0;  // Σ w (q − q̄)(p − p̄)ᵀ
+  if (rows >= 3) {
+    Eigen::Matrix3d C = C0;
     if (opt.rotation_prior > 0) C += opt.rotation_prior * p2 * Eigen::Matrix3d::Identity();
     Eigen::JacobiSVD<Eigen::Matrix3d> svd(C, Eigen::ComputeFullU | Eigen::ComputeFullV);
     const Eigen::Vector3d sv = svd.singularValues();
@@ -44,16 +44,20 @@ RigidFit rigid_fit_centred(const Eigen::MatrixXd& P0, const Eigen::MatrixXd& Q0,
       fit.residual2 = std::max(0.0, p2 + q2 - 2 * tr);
     }
   } else {
-    // R fixed (snapped, or I when degenerate): least-squares s = Σ (R p̃)·q̃ / Σ |R p̃|².
-    const Eigen::MatrixXd Pr = P0 * fit.R.transpose();
-    if (opt.scale) {
-      const double den = Pr.squaredNorm();
-      fit.s = den > 0 ? (Pr.cwiseProduct(Q0)).sum() / den : 1.0;
-    }
-    fit.residual2 = (fit.s * Pr - Q0).squaredNorm();
+    // R fixed (snapped, or I when degenerate): least-squares s = Σ (R p̃)·q̃ / Σ |R p̃|², where
+    // Σ (R p̃)·q̃ = tr(R Cᵀ) and |R p̃| = |p̃|.
+    const double rc = fit.R.cwiseProduct(C0).sum();
+    if (opt.scale) fit.s = p2 > 0 ? rc / p2 : 1.0;
+    fit.residual2 = std::max(0.0, fit.s * fit.s * p2 - 2 * fit.s * rc + q2);
   }
   fit.t = (qc - fit.s * pc * fit.R.transpose()).transpose();
   return fit;
+}
+
+RigidFit rigid_fit_centred(const Eigen::MatrixXd& P0, const Eigen::MatrixXd& Q0, const Eigen::RowVector3d& pc,
+                           const Eigen::RowVector3d& qc, const RigidFitOptions& opt) {
+  const Eigen::Matrix3d C = Q0.transpose() * P0;  // Σ w (q − q̄)(p − p̄)ᵀ
+  return rigid_fit_from_moments(C, P0.squaredNorm(), Q0.squaredNorm(), P0.rows(), pc, qc, opt);
 }
 
 }  // namespace rigid_fit_detail
@@ -72,6 +76,40 @@ RigidFit fit_rigid(const Eigen::MatrixXd& P, const Eigen::MatrixXd& Q, const Eig
   const Eigen::MatrixXd P0 = sw.asDiagonal() * (P.rowwise() - pc).eval();
   const Eigen::MatrixXd Q0 = sw.asDiagonal() * (Q.rowwise() - qc).eval();
   return rigid_fit_detail::rigid_fit_centred(P0, Q0, pc, qc, options);
+}
+
+RigidFitFromRest::RigidFitFromRest(const Eigen::MatrixXd& P, const std::vector<int>& rows, const Eigen::VectorXd& w,
+                                   const RigidFitOptions& options)
+    : rows_(rows), w_(w.cwiseMax(0.0)), opt_(options) {
+  const long n = static_cast<long>(rows_.size());
+  total_ = w.sum();
+  pc_.setZero();
+  if (n == 0 || !(total_ > 0)) return;
+  for (long k = 0; k < n; ++k) pc_ += w[k] * P.row(rows_[k]);
+  pc_ /= total_;
+  Pw_.resize(3, n);
+  p2_ = 0;
+  for (long k = 0; k < n; ++k) {
+    const Eigen::Vector3d d = (P.row(rows_[k]) - pc_).transpose();
+    Pw_.col(k) = w_[k] * d;
+    p2_ += w_[k] * d.squaredNorm();
+  }
+}
+
+RigidFit RigidFitFromRest::fit(const Eigen::MatrixXd& X) const {
+  const long n = static_cast<long>(rows_.size());
+  Eigen::RowVector3d qc = Eigen::RowVector3d::Zero();
+  if (n == 0 || !(total_ > 0)) return rigid_fit_detail::rigid_fit_from_moments(Eigen::Matrix3d::Zero(), 0, 0, n, pc_, qc, opt_);
+  for (long k = 0; k < n; ++k) qc += w_[k] * X.row(rows_[k]);
+  qc /= total_;
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+  double q2 = 0;
+  for (long k = 0; k < n; ++k) {
+    const Eigen::Vector3d q = (X.row(rows_[k]) - qc).transpose();
+    C.noalias() += q * Pw_.col(k).transpose();  // Σ w (q − q̄)(p − p̄)ᵀ
+    q2 += w_[k] * q.squaredNorm();
+  }
+  return rigid_fit_detail::rigid_fit_from_moments(C, p2_, q2, n, pc_, qc, opt_);
 }
 
 Eigen::Matrix3d nearest_axis_rotation(const Eigen::Matrix3d& R) {

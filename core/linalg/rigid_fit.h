@@ -7,6 +7,8 @@
 // t = q̄ − s·R·p̄. R is the rotation of polar_decomposition(C) (linalg/polar.h), bit for bit.
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Core>
 
 namespace mm {
@@ -40,6 +42,31 @@ RigidFit fit_rigid(const Eigen::MatrixXd& P, const Eigen::MatrixXd& Q, const Rig
 // Weighted: w (n, ≥ 0, not all zero) weighs each correspondence (centroids are weighted too).
 RigidFit fit_rigid(const Eigen::MatrixXd& P, const Eigen::MatrixXd& Q, const Eigen::VectorXd& w,
                    const RigidFitOptions& options = {});
+
+// The weighted fit of fixed rest points onto targets that change from call to call (a bone's
+// vertices in each frame of a clip): what depends on the rest points and weights alone (their
+// centroid, the weighted centred rows, Σw|p̃|²) is computed once, and each fit is two passes over
+// the targets and a 3×3 SVD, without allocating. The same fit as fit_rigid(P(rows), X(rows), w)
+// to rounding.
+class RigidFitFromRest {
+ public:
+  RigidFitFromRest() = default;
+  // The rest points are P's rows `rows`, weighed by w (one per row, ≥ 0).
+  RigidFitFromRest(const Eigen::MatrixXd& P, const std::vector<int>& rows, const Eigen::VectorXd& w,
+                   const RigidFitOptions& options);
+  // The fit onto X's rows `rows` (X has P's shape). Degenerate without points or weight.
+  RigidFit fit(const Eigen::MatrixXd& X) const;
+  int size() const { return static_cast<int>(rows_.size()); }
+  double total_weight() const { return total_; }
+
+ private:
+  std::vector<int> rows_;
+  Eigen::VectorXd w_;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> Pw_;  // w (p − p̄), one column per point
+  Eigen::RowVector3d pc_ = Eigen::RowVector3d::Zero();
+  double total_ = 0, p2_ = 0;
+  RigidFitOptions opt_;
+};
 
 // The axis-aligned rotation (one of 24: signed permutation matrices with det +1) nearest to R,
 // i.e. maximising tr(CᵀR); ties go to the first in a fixed order (identity first).

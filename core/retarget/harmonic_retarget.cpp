@@ -263,7 +263,6 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
   }
   base_on_ = opt.articulated_base && !bones_.empty();
   if (base_on_) {
-    Xs_rest_ = Xs;
     Xt_rest_ = Xt;
     const bool use_skin = opt.base_skin_weights && usable_skin(source.skin, Xs.rows());
     // Leaf bones only with the skin: learned weights spread worse over the extra candidates
@@ -276,26 +275,31 @@ Status HarmonicRetargeter::precompute(const RetargetCharacter& source, const Ret
     // without such vertices takes every vertex it has a share of, weighed by w².
     auto fit_sets = [&](const BoneBlend& w) {
       const double tau = std::clamp(opt.base_fit_weight, 0.0, 0.99);
-      base_fit_set_.assign(nb, {});
-      base_fit_w_.assign(nb, {});
-      std::vector<std::vector<int>> loose(nb);
-      std::vector<std::vector<double>> loose_w(nb);
+      std::vector<std::vector<int>> set(nb), loose(nb);
+      std::vector<std::vector<double>> set_w(nb), loose_w(nb);
       for (int i = 0; i < w.rows(); ++i)
         for (int k = w.ptr[i]; k < w.ptr[i + 1]; ++k) {
           const int b = w.bone[k];
           const double r = (w.w[k] - tau) / (1 - tau);
           if (r > 0) {
-            base_fit_set_[b].push_back(i);
-            base_fit_w_[b].push_back(r * r);
+            set[b].push_back(i);
+            set_w[b].push_back(r * r);
           }
           loose[b].push_back(i);
           loose_w[b].push_back(w.w[k] * w.w[k]);
         }
-      for (int b = 0; b < nb; ++b)
-        if (base_fit_set_[b].size() < 4) {
-          base_fit_set_[b] = loose[b];
-          base_fit_w_[b] = loose_w[b];
-        }
+      // A small pull towards no rotation (1e-3 of the set's spread): a thin or flat set (an ear, a
+      // tail tip) leaves a rotation about its degenerate axis undetermined, and a plain SVD then
+      // picks it from rounding noise.
+      RigidFitOptions fo;
+      fo.rotation_prior = 1e-3;
+      base_fits_.assign(nb, {});
+      for (int b = 0; b < nb; ++b) {
+        const bool tight = set[b].size() >= 4;
+        const std::vector<double>& wb = tight ? set_w[b] : loose_w[b];
+        base_fits_[b] = RigidFitFromRest(Xs, tight ? set[b] : loose[b],
+                                         Eigen::Map<const Eigen::VectorXd>(wb.data(), static_cast<Eigen::Index>(wb.size())), fo);
+      }
     };
     // Weights learned from the clip (surface only: which bones' motions explain each source
     // vertex over the sample frames), carried to the target through bone coordinates.
@@ -492,22 +496,9 @@ BoneMotions HarmonicRetargeter::source_bone_motions(const Eigen::MatrixXd& Xs) c
   M.t = Eigen::MatrixXd::Zero(nb, 3);
   std::vector<char> fitted(nb, 0);
   for (int b = 0; b < nb; ++b) {
-    const std::vector<int>& set = base_fit_set_[b];
-    if (set.size() < 4) continue;
-    Eigen::MatrixXd P(set.size(), 3), Q(set.size(), 3);
-    Eigen::VectorXd w(set.size());
-    for (size_t k = 0; k < set.size(); ++k) {
-      P.row(k) = Xs_rest_.row(set[k]);
-      Q.row(k) = Xs.row(set[k]);
-      w[k] = base_fit_w_[b][k];
-    }
-    // A small pull towards no rotation (1e-3 of the set's spread): a thin or flat set (an ear, a
-    // tail tip) leaves a rotation about its degenerate axis undetermined, and a plain SVD then
-    // picks it from rounding noise.
-    if (!(w.sum() > 0)) continue;
-    RigidFitOptions fo;
-    fo.rotation_prior = 1e-3;
-    const RigidFit f = fit_rigid(P, Q, w, fo);
+    const RigidFitFromRest& fit = base_fits_[b];
+    if (fit.size() < 4 || !(fit.total_weight() > 0)) continue;
+    const RigidFit f = fit.fit(Xs);
     if (f.degenerate || !f.R.allFinite()) continue;
     M.R[b] = f.R;
     M.t.row(b) = f.t.transpose();

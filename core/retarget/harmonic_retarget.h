@@ -49,6 +49,7 @@
 
 #include "common/progress.h"
 #include "common/status.h"
+#include "linalg/rigid_fit.h"
 #include "retarget/bone_blend.h"
 #include "retarget/context_graph.h"
 #include "retarget/harmonic_map.h"
@@ -251,9 +252,8 @@ class HarmonicRetargeter {
   // Articulated base.
   bool base_on_ = false;
   std::vector<Eigen::MatrixXd> base_frames_;
-  Eigen::MatrixXd Xs_rest_, Xt_rest_, colloc_rest_s_;  // working frames
-  std::vector<std::vector<int>> base_fit_set_;         // per bone: source vertices of its rigid fit
-  std::vector<std::vector<double>> base_fit_w_;        // and their weights in it
+  Eigen::MatrixXd Xt_rest_, colloc_rest_s_;  // working frames
+  std::vector<RigidFitFromRest> base_fits_;            // per bone: the rigid fit of its source vertices
   BoneBlend blend_colloc_s_, blend_verts_t_;
   std::vector<std::pair<int, int>> base_bones_;       // bones_, then leaf bones (joint → tip)
   Eigen::MatrixXd base_Js_rest_, base_Jt_rest_;       // used joints, then the leaf bones' tips (working)
