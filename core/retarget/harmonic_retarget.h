@@ -252,8 +252,8 @@ class HarmonicRetargeter {
   // Articulated base.
   bool base_on_ = false;
   std::vector<Eigen::MatrixXd> base_frames_;
-  Eigen::MatrixXd Xt_rest_, colloc_rest_s_;  // working frames
-  std::vector<RigidFitFromRest> base_fits_;            // per bone: the rigid fit of its source vertices
+  Eigen::MatrixXd Xt_rest_, colloc_rest_s_;          // working frames
+  std::vector<RigidFitFromRest> base_fits_;           // per bone: the rigid fit of its source vertices
   BoneBlend blend_colloc_s_, blend_verts_t_;
   std::vector<std::pair<int, int>> base_bones_;       // bones_, then leaf bones (joint → tip)
   Eigen::MatrixXd base_Js_rest_, base_Jt_rest_;       // used joints, then the leaf bones' tips (working)

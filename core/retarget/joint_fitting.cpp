@@ -98,24 +98,6 @@ struct JfTree {
   Eigen::Vector3d pos(int i) const { return s->nodes.row(i).transpose(); }
 };
 
-// The closest point to p on the tree's edges listed in `edges` (node u to its parent); its edge
-// and parameter from u in *edge, *t (-1, 0 and the root's position when there is none).
-Eigen::Vector3d jf_closest_on_edges(const JfTree& tree, const Eigen::Vector3d& p, const std::vector<int>& edges,
-                                    int* edge, double* t) {
-  double best = std::numeric_limits<double>::infinity();
-  Eigen::Vector3d c = tree.pos(tree.s->root);
-  *edge = -1, *t = 0;
-  for (int u : edges) {
-    const Eigen::Vector3d a = tree.pos(u), b = tree.pos(tree.s->parent[u]);
-    const double l2 = (b - a).squaredNorm();
-    const double x = l2 > 0 ? std::clamp((p - a).dot(b - a) / l2, 0.0, 1.0) : 0.0;
-    const Eigen::Vector3d y = a + x * (b - a);
-    const double d = (p - y).squaredNorm();
-    if (d < best) best = d, c = y, *edge = u, *t = x;
-  }
-  return c;
-}
-
 // A path with cumulative arc lengths.
 struct JfPath {
   std::vector<int> nodes;
@@ -788,7 +770,18 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
         for (int x = i; x >= 0 && leaves_below[x] == 1; x = SS.parent[x]) only_leaf[x] = i;
   }
   auto closest_on_edges = [&](const Eigen::Vector3d& p, const std::vector<int>& edges, int* edge, double* t) {
-    return jf_closest_on_edges(st, p, edges, edge, t);
+    double best = std::numeric_limits<double>::infinity();
+    Eigen::Vector3d q = st.pos(SS.root);
+    *edge = -1, *t = 0;
+    for (int u : edges) {
+      const Eigen::Vector3d a = st.pos(u), b = st.pos(SS.parent[u]);
+      const double l2 = (b - a).squaredNorm();
+      const double x = l2 > 0 ? std::clamp((p - a).dot(b - a) / l2, 0.0, 1.0) : 0.0;
+      const Eigen::Vector3d c = a + x * (b - a);
+      const double d = (p - c).squaredNorm();
+      if (d < best) best = d, q = c, *edge = u, *t = x;
+    }
+    return q;
   };
   std::vector<int> all_edges;
   for (int i = 0; i < ns; ++i)
