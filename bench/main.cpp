@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/process.h"
 #include "common/threads.h"
 #include "bench.h"
 
@@ -56,6 +57,9 @@ double Context::time_ms(const std::function<void()>& fn, int repeats) const {
 }  // namespace mm::bench
 
 int main(int argc, char** argv) {
+  // The CLI's process settings (huge pages for malloc, freed memory kept), so that the rows are
+  // what `meshmorph` runs at; MM_NO_HUGE_PAGES=1 keeps 4 KB pages (common/process.h).
+  mm::tune_process_memory(argv);
   using namespace mm::bench;
   Context ctx;
   std::string json_path;

@@ -311,6 +311,27 @@ TEST(Validate, OnePassTopologyAgreesWithTheSeparateFunctions) {
     EXPECT_EQ(r.count(MeshDefect::NonManifoldEdge), fins);
     EXPECT_EQ(r.boundary_loops, boundary_loops(Fv, n));
     EXPECT_EQ(r.count(MeshDefect::NonManifoldVertex), static_cast<int>(non_manifold_vertices(Fv, n).size()));
+    // The adjacency-slot counts (no sorting of edges) against edge_uses, and the boundary flags.
+    const auto adj = vertex_adjacency(Fv, n);
+    const EdgeFaceCounts counts = edge_face_counts(Fv, adj);
+    std::vector<char> boundary(static_cast<size_t>(n), 0);
+    size_t e = 0;
+    for (int a = 0; a < n; ++a)
+      for (size_t k = 0; k < adj[a].size(); ++k) {
+        const int faces = counts.faces[static_cast<size_t>(counts.start[a]) + k];
+        if (adj[a][k] < a) {
+          EXPECT_EQ(faces, 0);
+          continue;
+        }
+        ASSERT_LT(e, edges.size());
+        EXPECT_EQ(edges[e].i, a);
+        EXPECT_EQ(edges[e].j, adj[a][k]);
+        EXPECT_EQ(edges[e].faces, faces);
+        if (faces == 1) boundary[a] = boundary[adj[a][k]] = 1;
+        ++e;
+      }
+    EXPECT_EQ(e, edges.size());
+    EXPECT_EQ(boundary_vertices(Fv, adj), boundary);
     std::map<std::pair<int, int>, int> directed;
     for (int f = 0; f < rows; ++f)
       for (int c = 0; c < 3; ++c) ++directed[{Fv(f, c), Fv(f, (c + 1) % 3)}];

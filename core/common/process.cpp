@@ -25,10 +25,13 @@ void tune_process_memory(char** argv) {
   // Big meshes allocate and free arrays of tens of MB at every stage (load, weld, validate). By
   // default glibc returns freed heap memory to the system, and the next array faults every page
   // in again: on a 1M-vertex mesh a third of `meshmorph info` was page faults. Keep freed memory
-  // for reuse, and grow the heap in larger steps.
+  // for reuse, and grow the heap in larger steps. Arrays up to 1 GB come from the heap too (not
+  // from their own mmap, which is returned at free): the edit precompute's factor alone is 111 MB
+  // at 52k vertices, and faulting it in again cost ~60 ms of each precompute (docs/bench.md,
+  // forty-second session). glibc 2.36 accepts this value from mallopt.
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
   mallopt(M_TOP_PAD, 64 << 20);
-  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  mallopt(M_MMAP_THRESHOLD, 1 << 30);
 #else
   (void)argv;
 #endif

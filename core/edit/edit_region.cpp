@@ -18,7 +18,7 @@ namespace edit_detail {
 // Non-manifold checks restricted to the faces around the unknowns (exact there: every face of an
 // edge or vertex of an unknown is in `faces`).
 Status edit_check_region_manifold(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const std::vector<int>& faces,
-                             const std::vector<char>& is_unknown) {
+                                  const std::vector<char>& is_unknown, const std::vector<std::vector<int>>& adjacency) {
   for (int f : faces) {
     const Eigen::Vector3d p0 = V.row(F(f, 0)).transpose(), p1 = V.row(F(f, 1)).transpose(),
                           p2 = V.row(F(f, 2)).transpose();
@@ -36,8 +36,11 @@ Status edit_check_region_manifold(const Eigen::MatrixXd& V, const Eigen::MatrixX
   Eigen::MatrixXi Fs(faces.size(), 3);
   for (size_t k = 0; k < faces.size(); ++k) Fs.row(static_cast<Eigen::Index>(k)) = F.row(faces[k]);
   int bad = 0, first_a = -1, first_b = -1;
-  for (const EdgeUse& e : edge_uses(Fs))
-    if (e.faces > 2 && bad++ == 0) first_a = e.i, first_b = e.j;
+  const EdgeFaceCounts uses = edge_face_counts(Fs, adjacency);
+  for (size_t a = 0; a < adjacency.size(); ++a)
+    for (size_t k = 0; k < adjacency[a].size(); ++k)
+      if (uses.faces[static_cast<size_t>(uses.start[a]) + k] > 2 && bad++ == 0)
+        first_a = static_cast<int>(a), first_b = adjacency[a][k];
   if (bad > 0)
     return Status::error(StatusCode::InvalidMesh, "the edited region has " + std::to_string(bad) +
                                                       " non-manifold edges, first at vertices " + std::to_string(first_a) +
@@ -127,7 +130,7 @@ Status LaplacianEditor::Impl::build_region(const Eigen::MatrixXd& Vin, const Eig
   std::vector<int> faces;
   for (int f = 0; f < F.rows(); ++f)
     if (unknown[F(f, 0)] || unknown[F(f, 1)] || unknown[F(f, 2)]) faces.push_back(f);
-  if (Status s = edit_check_region_manifold(V, F, faces, unknown); !s.ok()) return s;
+  if (Status s = edit_check_region_manifold(V, F, faces, unknown, adj); !s.ok()) return s;
   for (int v : U)
     if (adj[v].empty())
       return Status::error(StatusCode::InvalidMesh, "vertex " + std::to_string(v) + " of the region of interest is isolated");
@@ -286,15 +289,34 @@ void LaplacianEditor::Impl::laplacian_rows(const EditBuild& s, const Eigen::Matr
   const EditSparse W = cot ? cotan_stiffness(P, Fsub) : uniform_laplacian(Fsub, n);
   Eigen::VectorXd area;
   if (cot) area = mass_diagonal(P, Fsub, MassType::Voronoi);
-  std::vector<EditTriplet> t;
   dscale->resize(nU);
   for (int l = 0; l < nU; ++l) {
     const int v = l2g[l];
-    for (EditSparse::InnerIterator it(W, v); it; ++it) t.emplace_back(l, g2l[it.row()], it.value());
     (*dscale)[l] = cot ? -2.0 / area[v] : -1.0 / static_cast<double>(adj[v].size());
   }
+  // Row l holds W's column v = l2g[l] in local numbering; W is symmetric bit for bit (each
+  // off-diagonal pair sums the same terms in the same order), so column k of the result is
+  // column l2g[k] of W restricted to the unknowns, already in ascending order (U is sorted,
+  // and the unknowns come first in the local numbering).
   Wout->resize(nU, nL);
-  Wout->setFromTriplets(t.begin(), t.end());
+  Eigen::Index total = 0;
+  for (int k = 0; k < nL; ++k)
+    for (EditSparse::InnerIterator it(W, l2g[k]); it; ++it) total += static_cast<unsigned>(g2l[it.row()]) < static_cast<unsigned>(nU) ? 1 : 0;
+  Wout->resizeNonZeros(total);
+  int* outer = Wout->outerIndexPtr();
+  int* rows = Wout->innerIndexPtr();
+  double* vals = Wout->valuePtr();
+  int at = 0;
+  for (int k = 0; k < nL; ++k) {
+    outer[k] = at;
+    for (EditSparse::InnerIterator it(W, l2g[k]); it; ++it) {
+      const int l = g2l[it.row()];
+      if (static_cast<unsigned>(l) >= static_cast<unsigned>(nU)) continue;
+      rows[at] = l;
+      vals[at++] = it.value();
+    }
+  }
+  outer[nL] = at;
 }
 
 }  // namespace mm

@@ -83,9 +83,7 @@ ImplicitGradients implicit_gradients(const Eigen::MatrixXd& V, const Eigen::Matr
   const int n = static_cast<int>(V.rows());
   const double thr = opt.condition_threshold;
 
-  std::vector<char> boundary(n, 0);
-  for (const auto& e : edge_uses(F))
-    if (e.faces == 1) boundary[e.i] = boundary[e.j] = 1;
+  const std::vector<char> boundary = boundary_vertices(F, adjacency);
   const Eigen::MatrixXd N = vertex_normals(V, F);
 
   // Stencil neighbours per center (1-ring, or 2-ring when widened).
@@ -124,19 +122,43 @@ ImplicitGradients implicit_gradients(const Eigen::MatrixXd& V, const Eigen::Matr
   // The paper traverses the vertex list once, testing each vertex against the positions
   // displaced so far (a displaced vertex usually also regularises its neighbours). We repeat
   // the traversal (at most 3 times) until nothing changes, so a vertex that an earlier
-  // displacement did not fix gets another chance.
+  // displacement did not fix gets another chance. A center that passed the test is not tested
+  // again unless a vertex of its stencil moved since (the same positions give the same spread);
+  // its spread is kept for the weights below.
+  std::vector<long> moved_at(n, -1);  // per vertex: the step of its last displacement
+  std::vector<long> tested_at(centers.size(), -1);
+  std::vector<char> passed(centers.size(), 0);
+  std::vector<Eigen::Vector3d> spread(centers.size());
+  long step = 0;
+  auto moved_since = [&](size_t c, long t) {
+    if (moved_at[centers[c]] >= t) return true;
+    for (int j : nbrs[c])
+      if (moved_at[j] >= t) return true;
+    return false;
+  };
+  auto test = [&](size_t c, EditSpread3* s) {
+    *s = edit_spread_of(edit_gram_of(P, centers[c], nbrs[c]));
+    tested_at[c] = step;
+    spread[c] = s->values;
+    passed[c] = edit_condition_of(s->values) <= thr;
+    return passed[c] != 0;
+  };
+  auto displace_at = [&](int v, const Eigen::Vector3d& plane_normal) {
+    displace(v, plane_normal);
+    moved_at[v] = ++step;
+  };
   for (int pass = 0; pass < 3; ++pass) {
     bool changed = false;
     for (size_t c = 0; c < centers.size(); ++c) {
       const int i = centers[c];
-      EditSpread3 s = edit_spread_of(edit_gram_of(P, i, nbrs[c]));
-      if (edit_condition_of(s.values) <= thr) continue;
+      if (pass > 0 && passed[c] && !moved_since(c, tested_at[c] + 1)) continue;
+      EditSpread3 s;
+      if (test(c, &s)) continue;
       if (pass == 0) was_degenerate[c] = 1;
       if (adjacency[i].size() < 3 && !is_widened[c]) {
         widen(c);
         changed = true;
-        s = edit_spread_of(edit_gram_of(P, i, nbrs[c]));
-        if (edit_condition_of(s.values) <= thr) continue;
+        if (test(c, &s)) continue;
       }
       const EditSpread3 ns = edit_spread_of(edit_neighbour_spread(P, nbrs[c]));
       const bool collinear = !(ns.values[1] > ns.values[2] / thr);
@@ -150,15 +172,16 @@ ImplicitGradients implicit_gradients(const Eigen::MatrixXd& V, const Eigen::Matr
             break;
           }
         if (pick >= 0) {
-          displace(pick, N.row(pick).transpose().squaredNorm() > 0 ? Eigen::Vector3d(N.row(pick).transpose())
-                                                                   : Eigen::Vector3d(s.vectors.col(0)));
+          displace_at(pick, N.row(pick).transpose().squaredNorm() > 0 ? Eigen::Vector3d(N.row(pick).transpose())
+                                                                      : Eigen::Vector3d(s.vectors.col(0)));
           changed = true;
         } else if (!is_widened[c]) {
           widen(c);
+          tested_at[c] = -1;  // its stencil changed: the kept spread is stale
           changed = true;
         }
       } else if (!displaced[i]) {
-        displace(i, s.vectors.col(0));
+        displace_at(i, s.vectors.col(0));
         changed = true;
       }
     }
@@ -168,11 +191,17 @@ ImplicitGradients implicit_gradients(const Eigen::MatrixXd& V, const Eigen::Matr
   // Weights of Eq. 4 on the displaced rest mesh: with P_i = V_iᵀ(V_i V_iᵀ)⁻¹ (rows p_k), the
   // centering by the neighbour centroid gives w_center = p_0 and w_j = p_j − (Σ_k p_k)/|N|.
   out.offsets.assign(1, 0);
+  size_t entries = 0;
+  for (const auto& list : nbrs) entries += list.size() + 1;
+  out.stencil.reserve(entries);
+  out.offsets.reserve(centers.size() + 1);
   std::vector<Eigen::Vector3d> w;
+  w.reserve(entries);
   for (size_t c = 0; c < centers.size(); ++c) {
     const int i = centers[c];
     const Eigen::Matrix3d G = edit_gram_of(P, i, nbrs[c]);
-    const double cond = edit_condition_of(edit_spread_of(G).values);
+    const bool fresh = tested_at[c] >= 0 && !moved_since(c, tested_at[c] + 1);
+    const double cond = edit_condition_of(fresh ? spread[c] : edit_spread_of(G).values);
     if (!(cond <= 1e12)) {
       out.status = Status::error(StatusCode::InvalidMesh,
                                  "the neighbourhood of vertex " + std::to_string(i) +
@@ -187,18 +216,16 @@ ImplicitGradients implicit_gradients(const Eigen::MatrixXd& V, const Eigen::Matr
     centroid /= static_cast<double>(nbrs[c].size());
     const Eigen::Vector3d p0 = Ginv * (P.row(i).transpose() - centroid);
     Eigen::Vector3d sum = p0;
-    std::vector<Eigen::Vector3d> pj(nbrs[c].size());
-    for (size_t k = 0; k < nbrs[c].size(); ++k) {
-      pj[k] = Ginv * (P.row(nbrs[c][k]).transpose() - centroid);
-      sum += pj[k];
-    }
-    const Eigen::Vector3d shift = sum / static_cast<double>(nbrs[c].size());
     out.stencil.push_back(i);
     w.push_back(p0);
-    for (size_t k = 0; k < nbrs[c].size(); ++k) {
-      out.stencil.push_back(nbrs[c][k]);
-      w.push_back(pj[k] - shift);
+    const size_t first = w.size();
+    for (int j : nbrs[c]) {
+      w.push_back(Ginv * (P.row(j).transpose() - centroid));
+      sum += w.back();
+      out.stencil.push_back(j);
     }
+    const Eigen::Vector3d shift = sum / static_cast<double>(nbrs[c].size());
+    for (size_t k = first; k < w.size(); ++k) w[k] -= shift;
     out.offsets.push_back(static_cast<int>(out.stencil.size()));
     if (was_degenerate[c]) out.degenerate.push_back(i);
     if (is_widened[c]) out.widened.push_back(i);

@@ -30,9 +30,10 @@ using EditTriplet = Eigen::Triplet<double>;
 // linalg/rigid_fit.h). Fewer than 3 points, or collinear points, give the identity.
 Eigen::Matrix3d edit_fit_similarity_linear(const Eigen::MatrixXd& P, const Eigen::MatrixXd& Q);
 
-// Non-manifold and degenerate-face checks restricted to the faces around the unknowns.
+// Non-manifold and degenerate-face checks restricted to the faces around the unknowns;
+// `adjacency` = vertex_adjacency(F, #V).
 Status edit_check_region_manifold(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const std::vector<int>& faces,
-                                  const std::vector<char>& is_unknown);
+                                  const std::vector<char>& is_unknown, const std::vector<std::vector<int>>& adjacency);
 
 // Milliseconds since `t0`; resets t0 to now.
 double edit_lap_ms(std::chrono::steady_clock::time_point* t0);

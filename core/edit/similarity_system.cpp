@@ -123,73 +123,126 @@ Status LaplacianEditor::Impl::build_similarity_system(EditBuild& s, const Progre
   }
   this->partner_ptr = partner_ptr;
   this->partners = partners;
-  // Y_a for active centers, as sparse lists (local vertex, 3-vector).
+  // Y_a for active centers, as sparse lists (local vertex, 3-vector). The stencils of the pair
+  // centers are first packed in pair order (local index and weights side by side), so that
+  // summing a center's partners reads one stream instead of four arrays through two indirections.
+  struct PackedEntry {
+    int j;
+    double w[3];
+  };
+  std::vector<int> pk_ptr(nP + 1, 0);
+  for (int p = 0; p < nP; ++p) {
+    const int c = center_index[pair_centers[p]];
+    pk_ptr[p + 1] = pk_ptr[p] + grads.offsets[c + 1] - grads.offsets[c];
+  }
+  std::vector<PackedEntry> pk(static_cast<size_t>(pk_ptr[nP]));
+  for (int p = 0; p < nP; ++p) {
+    const int c = center_index[pair_centers[p]];
+    PackedEntry* out = pk.data() + pk_ptr[p];
+    for (int e = grads.offsets[c]; e < grads.offsets[c + 1]; ++e, ++out) {
+      out->j = stencil_local[e];
+      for (int k = 0; k < 3; ++k) out->w[k] = grads.weights(e, k);
+    }
+  }
+  // Y_p is needed only by the columns i of p's stencil, and only at rows j ≥ i < nU (the lower
+  // triangle of N_UU). Its entries are kept in buckets between the stencil's sorted indices
+  // (a counting sort of ~40 entries into ~8 buckets, instead of sorting them), so a column i
+  // reads Y_p from the first bucket at or above i with no search; y_from[x] is that start for
+  // the packed stencil entry x of i. Entries below the stencil's smallest index, or known
+  // (j ≥ nU), are never read and not kept. Each kept sum is untouched, so N is the same.
   std::vector<double> acc3(3 * static_cast<size_t>(nL), 0.0);
-  std::vector<int> mark(nL, -1), touched;
-  std::vector<int> y_ptr(nP + 1, 0), y_idx;
+  std::vector<char> mark(nL, 0);
+  std::vector<int> touched, bucket_of, thresholds, bucket_start;
+  std::vector<int> y_from(pk.size(), 0), y_stop(nP, 0), y_idx;
   std::vector<double> y_val;
   {
     // Reserved at an upper bound (Σ of the stencil sizes over each list's centers) instead of
     // grown: growing copied these lists (~2M entries at 50k vertices) several times over.
-    size_t bound = 0;
-    auto stencil_size = [&](int q) {
-      const int c = center_index[pair_centers[q]];
-      return static_cast<size_t>(grads.offsets[c + 1] - grads.offsets[c]);
-    };
+    size_t bound = 0, most = 0;
     for (int p = 0; p < nP; ++p) {
       if (!is_active[center_index[pair_centers[p]]]) continue;
-      bound += stencil_size(p);
-      for (int k = partner_ptr[p]; k < partner_ptr[p + 1]; ++k) bound += stencil_size(partners[k]);
+      size_t here = static_cast<size_t>(pk_ptr[p + 1] - pk_ptr[p]);
+      for (int k = partner_ptr[p]; k < partner_ptr[p + 1]; ++k)
+        here += static_cast<size_t>(pk_ptr[partners[k] + 1] - pk_ptr[partners[k]]);
+      bound += here;
+      most = std::max(most, here);
     }
     y_idx.reserve(bound);
     y_val.reserve(3 * bound);
+    touched.resize(most);
+    bucket_of.resize(most);
   }
   for (int p = 0; p < nP; ++p) {
-    y_ptr[p + 1] = y_ptr[p];
-    if (!is_active[center_index[pair_centers[p]]]) continue;
-    touched.clear();
+    if (!is_active[center_index[pair_centers[p]]]) {
+      std::fill(y_from.begin() + pk_ptr[p], y_from.begin() + pk_ptr[p + 1], static_cast<int>(y_idx.size()));
+      y_stop[p] = static_cast<int>(y_idx.size());
+      continue;
+    }
+    size_t t = 0;
     auto add_stencil = [&](int q, double g) {
-      const int c = center_index[pair_centers[q]];
-      for (int e = grads.offsets[c]; e < grads.offsets[c + 1]; ++e) {
-        const int j = stencil_local[e];
-        if (mark[j] != p) {
-          mark[j] = p;
-          touched.push_back(j);
-          acc3[3 * j] = acc3[3 * j + 1] = acc3[3 * j + 2] = 0.0;
+      for (const PackedEntry* x = pk.data() + pk_ptr[q]; x != pk.data() + pk_ptr[q + 1]; ++x) {
+        double* a = acc3.data() + 3 * static_cast<size_t>(x->j);
+        if (!mark[x->j]) {
+          mark[x->j] = 1;
+          touched[t++] = x->j;
+          a[0] = a[1] = a[2] = 0.0;
         }
-        for (int k = 0; k < 3; ++k) acc3[3 * j + k] += g * grads.weights(e, k);
+        for (int k = 0; k < 3; ++k) a[k] += g * x->w[k];
       }
     };
     add_stencil(p, static_cast<double>(partner_ptr[p + 1] - partner_ptr[p]));
     for (int k = partner_ptr[p]; k < partner_ptr[p + 1]; ++k) add_stencil(partners[k], -1.0);
-    std::sort(touched.begin(), touched.end());  // sorted: the column loop below starts at the diagonal
-    for (int j : touched) {
-      y_idx.push_back(j);
-      for (int k = 0; k < 3; ++k) y_val.push_back(opt.coherence_weight * acc3[3 * j + k]);
+    for (size_t u = 0; u < t; ++u) mark[touched[u]] = 0;
+    // Buckets: b = the number of p's stencil indices ≤ j (0: below them all, not kept).
+    thresholds.clear();
+    for (int x = pk_ptr[p]; x < pk_ptr[p + 1]; ++x) thresholds.push_back(pk[x].j);
+    std::sort(thresholds.begin(), thresholds.end());
+    const int m = static_cast<int>(thresholds.size());
+    bucket_start.assign(m + 2, 0);
+    for (size_t u = 0; u < t; ++u) {
+      const int j = touched[u];
+      int b = 0;
+      if (j < nU)
+        while (b < m && thresholds[b] <= j) ++b;
+      bucket_of[u] = b;
+      ++bucket_start[b + 1];
     }
-    y_ptr[p + 1] = static_cast<int>(y_idx.size());
+    const int base = static_cast<int>(y_idx.size());
+    bucket_start[1] = 0;  // bucket 0 is dropped
+    for (int b = 1; b <= m; ++b) bucket_start[b + 1] += bucket_start[b];
+    const int kept = bucket_start[m + 1];
+    y_idx.resize(static_cast<size_t>(base + kept));
+    y_val.resize(3 * static_cast<size_t>(base + kept));
+    for (int x = pk_ptr[p]; x < pk_ptr[p + 1]; ++x) {
+      const int rank = static_cast<int>(std::lower_bound(thresholds.begin(), thresholds.end(), pk[x].j) - thresholds.begin());
+      y_from[x] = base + bucket_start[rank + 1];
+    }
+    for (size_t u = 0; u < t; ++u) {
+      const int b = bucket_of[u];
+      if (b == 0) continue;
+      const size_t at = static_cast<size_t>(base + bucket_start[b]++);
+      const int j = touched[u];
+      y_idx[at] = j;
+      for (int k = 0; k < 3; ++k) y_val[3 * at + k] = opt.coherence_weight * acc3[3 * j + k];
+    }
+    y_stop[p] = base + kept;
   }
-  // Reverse index: for each unknown, the (pair center, stencil entry) pairs that contain it.
+  // Reverse index: for each unknown, the (pair center, packed stencil entry) pairs that contain it.
   std::vector<int> rev_ptr(nU + 1, 0), rev_center, rev_entry;
-  for (int p = 0; p < nP; ++p) {
-    const int c = center_index[pair_centers[p]];
-    for (int e = grads.offsets[c]; e < grads.offsets[c + 1]; ++e)
-      if (stencil_local[e] < nU) ++rev_ptr[stencil_local[e] + 1];
-  }
+  for (const PackedEntry& x : pk)
+    if (x.j < nU) ++rev_ptr[x.j + 1];
   for (int i = 0; i < nU; ++i) rev_ptr[i + 1] += rev_ptr[i];
   rev_center.resize(rev_ptr[nU]);
   rev_entry.resize(rev_ptr[nU]);
   {
     std::vector<int> fill(rev_ptr.begin(), rev_ptr.end() - 1);
-    for (int p = 0; p < nP; ++p) {
-      const int c = center_index[pair_centers[p]];
-      for (int e = grads.offsets[c]; e < grads.offsets[c + 1]; ++e) {
-        const int i = stencil_local[e];
+    for (int p = 0; p < nP; ++p)
+      for (int x = pk_ptr[p]; x < pk_ptr[p + 1]; ++x) {
+        const int i = pk[x].j;
         if (i >= nU) continue;
         rev_center[fill[i]] = p;
-        rev_entry[fill[i]++] = e;
+        rev_entry[fill[i]++] = x;
       }
-    }
   }
   // Transformation-constraint rows (Eq. 7) at handle vertices whose gradient has an unknown (their
   // right-hand side, the handle's linear part, enters through stage1_normal_residual).
@@ -235,20 +288,13 @@ Status LaplacianEditor::Impl::build_similarity_system(EditBuild& s, const Progre
         acc[j] += v;
       };
       for (int k = rev_ptr[i]; k < rev_ptr[i + 1]; ++k) {
-        const int p = rev_center[k], e = rev_entry[k];
-        const double s0 = grads.weights(e, 0), s1 = grads.weights(e, 1), s2 = grads.weights(e, 2);
-        const int* y_begin = y_idx.data() + y_ptr[p];
-        const int* y_end = y_idx.data() + y_ptr[p + 1];
-        for (const int* y = std::lower_bound(y_begin, y_end, i); y != y_end; ++y) {
-          const size_t q = static_cast<size_t>(y - y_idx.data());
-          add(*y, s0 * y_val[3 * q] + s1 * y_val[3 * q + 1] + s2 * y_val[3 * q + 2]);
-        }
-        if (grad_row[p]) {
-          const int c = center_index[pair_centers[p]];
-          for (int f = grads.offsets[c]; f < grads.offsets[c + 1]; ++f)
-            if (stencil_local[f] >= i)
-              add(stencil_local[f], wg * (s0 * grads.weights(f, 0) + s1 * grads.weights(f, 1) + s2 * grads.weights(f, 2)));
-        }
+        const int p = rev_center[k], x = rev_entry[k];
+        const double s0 = pk[x].w[0], s1 = pk[x].w[1], s2 = pk[x].w[2];
+        for (int q = y_from[x]; q < y_stop[p]; ++q)
+          add(y_idx[q], s0 * y_val[3 * q] + s1 * y_val[3 * q + 1] + s2 * y_val[3 * q + 2]);
+        if (grad_row[p])
+          for (const PackedEntry* f = pk.data() + pk_ptr[p]; f != pk.data() + pk_ptr[p + 1]; ++f)
+            if (f->j >= i) add(f->j, wg * (s0 * f->w[0] + s1 * f->w[1] + s2 * f->w[2]));
       }
       for (EditSparse::InnerIterator er(Ecol, i); er; ++er) {
         const int* row_end = e_cols + Erow.outerIndexPtr()[er.row() + 1];

@@ -1,6 +1,7 @@
 #include "mesh/topology.h"
 
 #include <algorithm>
+#include <cassert>
 #include <functional>
 #include <numeric>
 #include <queue>
@@ -127,6 +128,36 @@ std::vector<EdgeUse> edge_uses(const Eigen::MatrixXi& F) {
   return out;
 }
 
+EdgeFaceCounts edge_face_counts(const Eigen::MatrixXi& F, const std::vector<std::vector<int>>& adjacency) {
+  const int n = static_cast<int>(adjacency.size());
+  EdgeFaceCounts out;
+  out.start.assign(static_cast<size_t>(n) + 1, 0);
+  for (int v = 0; v < n; ++v) out.start[v + 1] = out.start[v] + static_cast<int>(adjacency[v].size());
+  out.faces.assign(static_cast<size_t>(out.start[n]), 0);
+  for (int f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      int a = F(f, c), b = F(f, (c + 1) % 3);
+      if (a == b) continue;
+      if (a > b) std::swap(a, b);
+      if (a < 0 || b >= n) continue;  // vertex_adjacency drops these too
+      const std::vector<int>& list = adjacency[a];
+      const auto it = std::lower_bound(list.begin(), list.end(), b);
+      assert(it != list.end() && *it == b && "edge_face_counts: adjacency is not the faces'");
+      if (it == list.end() || *it != b) continue;
+      ++out.faces[static_cast<size_t>(out.start[a] + (it - list.begin()))];
+    }
+  return out;
+}
+
+std::vector<char> boundary_vertices(const Eigen::MatrixXi& F, const std::vector<std::vector<int>>& adjacency) {
+  const EdgeFaceCounts counts = edge_face_counts(F, adjacency);
+  std::vector<char> boundary(adjacency.size(), 0);
+  for (size_t a = 0; a < adjacency.size(); ++a)
+    for (size_t k = 0; k < adjacency[a].size(); ++k)
+      if (counts.faces[static_cast<size_t>(counts.start[a]) + k] == 1) boundary[a] = boundary[adjacency[a][k]] = 1;
+  return boundary;
+}
+
 std::vector<VertexFans> non_manifold_vertices(const Eigen::MatrixXi& F, int n, const std::vector<char>* only) {
   const VertexBuckets vf_corners = bucket_by_vertex(n, static_cast<int>(F.rows()) * 3, [&](int h) {
     const int v = F(h / 3, h % 3);
@@ -135,7 +166,9 @@ std::vector<VertexFans> non_manifold_vertices(const Eigen::MatrixXi& F, int n, c
   std::vector<int> faces;
   std::vector<VertexFans> out;
   std::vector<int> parent;
-  std::vector<std::pair<int, int>> spokes;
+  // Per other vertex w: the vertex whose fans are being traced when w was last seen as a spoke,
+  // and the first of its faces found on the spoke (v, w). Faces sharing a spoke share an edge at v.
+  std::vector<int> spoke_of(static_cast<size_t>(std::max(n, 0)), -1), spoke_face(static_cast<size_t>(std::max(n, 0)), 0);
   for (int v = 0; v < n; ++v) {
     faces.clear();
     for (int k = vf_corners.start[v]; k < vf_corners.start[v + 1]; ++k) faces.push_back(vf_corners.items[k] / 3);
@@ -146,15 +179,16 @@ std::vector<VertexFans> non_manifold_vertices(const Eigen::MatrixXi& F, int n, c
       while (parent[x] != x) x = parent[x] = parent[parent[x]];
       return x;
     };
-    // (other vertex, local face) pairs; faces sharing an other vertex share an edge at v.
-    spokes.clear();
     for (size_t k = 0; k < faces.size(); ++k)
-      for (int c = 0; c < 3; ++c)
-        if (F(faces[k], c) != v) spokes.push_back({F(faces[k], c), static_cast<int>(k)});
-    std::sort(spokes.begin(), spokes.end());
-    for (size_t s = 1; s < spokes.size(); ++s)
-      if (spokes[s].first == spokes[s - 1].first) {
-        const int ra = find(spokes[s].second), rb = find(spokes[s - 1].second);
+      for (int c = 0; c < 3; ++c) {
+        const int w = F(faces[k], c);
+        if (w == v) continue;
+        if (spoke_of[w] != v) {
+          spoke_of[w] = v;
+          spoke_face[w] = static_cast<int>(k);
+          continue;
+        }
+        const int ra = find(static_cast<int>(k)), rb = find(spoke_face[w]);
         if (ra != rb) parent[ra] = rb;
       }
     int fans = 0;

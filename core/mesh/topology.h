@@ -77,6 +77,20 @@ struct EdgeUse {
 };
 std::vector<EdgeUse> edge_uses(const Eigen::MatrixXi& F);
 
+// Faces per undirected edge, counted in the edge's smaller vertex's adjacency list: entry
+// start[a] + k (start = prefix sums of the lists' sizes, n + 1 of them) counts the faces of F
+// using edge (a, adjacency[a][k]) when a < adjacency[a][k] (0 for the other direction). The same
+// counts as edge_uses without sorting or bucketing; `adjacency` must be vertex_adjacency of a
+// superset of F's faces (sorted lists).
+struct EdgeFaceCounts {
+  std::vector<int> start, faces;
+};
+EdgeFaceCounts edge_face_counts(const Eigen::MatrixXi& F, const std::vector<std::vector<int>>& adjacency);
+
+// Per vertex: 1 if it ends an edge used by exactly one face (the same flags as edge_uses'
+// faces == 1), with `adjacency` = vertex_adjacency(F, n).
+std::vector<char> boundary_vertices(const Eigen::MatrixXi& F, const std::vector<std::vector<int>>& adjacency);
+
 // Non-manifold vertices: the faces around a vertex must form one fan (faces connected through
 // edges incident to the vertex). Returns (vertex, number of fans) for every vertex with more
 // than one fan, ascending. F: faces without repeated indices; `only` (size n) restricts the

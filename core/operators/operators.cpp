@@ -1,6 +1,8 @@
 #include "operators/operators.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -13,27 +15,77 @@ Eigen::Vector3d row3(const Eigen::MatrixXd& V, int i) { return V.row(i).transpos
 }  // namespace
 
 SparseMatrix cotan_stiffness(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  // Assembled column by column in place (no triplets to sort): each entry sums the same terms
+  // in the same order as triplets (i, j, −½cot), (j, i, −½cot), (i, i, ½cot), (j, j, ½cot) per
+  // corner, face by face, would (faces ascending, corners in order), so the matrix is the same
+  // bit for bit as a setFromTriplets of them. Sums start at −0 (−0 + x = x for every x).
   const int n = static_cast<int>(V.rows());
-  std::vector<Eigen::Triplet<double>> t;
-  t.reserve(F.rows() * 12);
-  for (int f = 0; f < F.rows(); ++f) {
+  const int nf = static_cast<int>(F.rows());
+  std::vector<double> half_cot(3 * static_cast<size_t>(nf));
+  std::vector<char> kept(static_cast<size_t>(nf), 0);
+  for (int f = 0; f < nf; ++f) {
     const int idx[3] = {F(f, 0), F(f, 1), F(f, 2)};
     const Eigen::Vector3d p[3] = {row3(V, idx[0]), row3(V, idx[1]), row3(V, idx[2])};
     const double dbl_area = (p[1] - p[0]).cross(p[2] - p[0]).norm();
     if (!(dbl_area > 0) || !std::isfinite(dbl_area)) continue;
+    kept[f] = 1;
     for (int c = 0; c < 3; ++c) {
       // Angle at corner c is opposite the edge (c+1, c+2): cot = (u·v) / |u×v|.
-      const int i = idx[(c + 1) % 3], j = idx[(c + 2) % 3];
       const Eigen::Vector3d u = p[(c + 1) % 3] - p[c], v = p[(c + 2) % 3] - p[c];
-      const double half_cot = 0.5 * u.dot(v) / dbl_area;
-      t.emplace_back(i, j, -half_cot);
-      t.emplace_back(j, i, -half_cot);
-      t.emplace_back(i, i, half_cot);
-      t.emplace_back(j, j, half_cot);
+      half_cot[3 * static_cast<size_t>(f) + c] = 0.5 * u.dot(v) / dbl_area;
+    }
+  }
+  // The kept faces of each vertex, ascending.
+  std::vector<int> start(static_cast<size_t>(n) + 1, 0), faces;
+  for (int f = 0; f < nf; ++f)
+    if (kept[f])
+      for (int c = 0; c < 3; ++c) ++start[static_cast<size_t>(F(f, c)) + 1];
+  for (int v = 0; v < n; ++v) start[v + 1] += start[v];
+  faces.resize(static_cast<size_t>(start[n]));
+  {
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (int f = 0; f < nf; ++f)
+      if (kept[f])
+        for (int c = 0; c < 3; ++c) faces[static_cast<size_t>(fill[F(f, c)]++)] = f;
+  }
+  // Column v: v and its neighbours through kept faces (each kept face puts two neighbours and v).
+  std::vector<int> outer(static_cast<size_t>(n) + 1, 0), inner, stamp(static_cast<size_t>(n), -1), slot(static_cast<size_t>(n), 0);
+  std::vector<double> values;
+  inner.reserve(faces.size() + static_cast<size_t>(n));
+  for (int v = 0; v < n; ++v) {
+    const size_t first = inner.size();
+    for (int k = start[v]; k < start[v + 1]; ++k) {
+      const int f = faces[static_cast<size_t>(k)];
+      for (int c = 0; c < 3; ++c) {
+        const int w = F(f, c);
+        if (stamp[w] != v) {
+          stamp[w] = v;
+          inner.push_back(w);
+        }
+      }
+    }
+    std::sort(inner.begin() + static_cast<std::ptrdiff_t>(first), inner.end());
+    outer[v + 1] = static_cast<int>(inner.size());
+  }
+  values.assign(inner.size(), -0.0);
+  for (int v = 0; v < n; ++v) {
+    for (int k = outer[v]; k < outer[v + 1]; ++k) slot[inner[static_cast<size_t>(k)]] = k;
+    for (int k = start[v]; k < start[v + 1]; ++k) {
+      const int f = faces[static_cast<size_t>(k)];
+      for (int c = 0; c < 3; ++c) {
+        const int i = F(f, (c + 1) % 3), j = F(f, (c + 2) % 3);
+        if (i != v && j != v) continue;
+        const double h = half_cot[3 * static_cast<size_t>(f) + c];
+        values[static_cast<size_t>(slot[i == v ? j : i])] += -h;
+        values[static_cast<size_t>(slot[v])] += h;
+      }
     }
   }
   SparseMatrix W(n, n);
-  W.setFromTriplets(t.begin(), t.end());
+  W.resizeNonZeros(static_cast<Eigen::Index>(inner.size()));
+  std::copy(outer.begin(), outer.end(), W.outerIndexPtr());
+  std::copy(inner.begin(), inner.end(), W.innerIndexPtr());
+  std::copy(values.begin(), values.end(), W.valuePtr());
   return W;
 }
 
