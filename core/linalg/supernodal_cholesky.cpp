@@ -587,15 +587,79 @@ static_assert(kSkinny == 8, "sn_skinny dispatches 1..8 right-hand sides");
 template <int K>
 constexpr int sn_panel_block() { return K <= 4 ? 8 : 4; }
 
+#if defined(__wasm_simd128__)
+// A row of K right-hand sides in wasm: ⌈K/2⌉ f64x2 lanes (for odd K the last one holds one value,
+// loaded and stored as a single double). Eigen 3.4 has no wasm packets, so its fixed-size arrays
+// ran these loops one double at a time. Element-wise, each entry rounds as the scalar code would
+// (a product, then a sum or difference; no fused operations).
+template <int K>
+struct SnRow {
+  static constexpr int P = (K + 1) / 2;
+  v128_t v[P];
+  void setZero() {
+    for (v128_t& x : v) x = wasm_f64x2_splat(0.0);
+  }
+};
+template <int K>
+struct SnScaled {
+  double s;
+  const SnRow<K>& y;
+};
+template <int K>
+SnScaled<K> operator*(double s, const SnRow<K>& y) {
+  return {s, y};
+}
+template <int K>
+SnRow<K> sn_load(const double* p) {
+  SnRow<K> r;
+  for (int i = 0; i < K / 2; ++i) r.v[i] = wasm_v128_load(p + 2 * i);
+  if constexpr (K % 2 == 1) r.v[K / 2] = wasm_v128_load64_zero(p + K - 1);
+  return r;
+}
+template <int K>
+void sn_store(double* p, const SnRow<K>& r) {
+  for (int i = 0; i < K / 2; ++i) wasm_v128_store(p + 2 * i, r.v[i]);
+  if constexpr (K % 2 == 1) wasm_v128_store64_lane(p + K - 1, r.v[K / 2], 0);
+}
+template <int K>
+SnRow<K>& operator+=(SnRow<K>& r, const SnScaled<K>& a) {
+  const v128_t s = wasm_f64x2_splat(a.s);
+  for (int i = 0; i < SnRow<K>::P; ++i) r.v[i] = wasm_f64x2_add(r.v[i], wasm_f64x2_mul(s, a.y.v[i]));
+  return r;
+}
+template <int K>
+SnRow<K>& operator-=(SnRow<K>& r, const SnScaled<K>& a) {
+  const v128_t s = wasm_f64x2_splat(a.s);
+  for (int i = 0; i < SnRow<K>::P; ++i) r.v[i] = wasm_f64x2_sub(r.v[i], wasm_f64x2_mul(s, a.y.v[i]));
+  return r;
+}
+template <int K>
+SnRow<K>& operator-=(SnRow<K>& r, const SnRow<K>& a) {
+  for (int i = 0; i < SnRow<K>::P; ++i) r.v[i] = wasm_f64x2_sub(r.v[i], a.v[i]);
+  return r;
+}
+template <int K>
+SnRow<K>& operator/=(SnRow<K>& r, double d) {
+  const v128_t s = wasm_f64x2_splat(d);
+  for (int i = 0; i < SnRow<K>::P; ++i) r.v[i] = wasm_f64x2_div(r.v[i], s);
+  return r;
+}
+#else
 // A row of K right-hand sides as an Eigen fixed-size array: Eigen's own packets over the row
 // (the compilers' auto-vectorisers instead vectorised the loops over rows, with in-order scalar
 // reductions). Element-wise, so each entry rounds as the scalar loop would.
 template <int K>
 using SnRow = Eigen::Array<double, K, 1>;
 template <int K>
-using SnRowMap = Eigen::Map<SnRow<K>>;
+SnRow<K> sn_load(const double* p) {
+  return Eigen::Map<const SnRow<K>>(p);
+}
 template <int K>
-using SnConstRowMap = Eigen::Map<const SnRow<K>>;
+void sn_store(double* p, const SnRow<K>& r) {
+  Eigen::Map<SnRow<K>> row(p);
+  row = r;
+}
+#endif
 
 // t += P y, or t −= P y with Subtract: P the nr by ncols panel (column-major, column stride
 // ld), y ncols by K and t nr by K (both row-major). B columns per pass over the rows; every
@@ -607,27 +671,28 @@ void sn_panel_update(const double* P, long ld, int nr, int ncols, const double* 
   for (; c + B <= ncols; c += B) {
     const double* p = P + c * ld;
     SnRow<K> yq[B];
-    for (int q = 0; q < B; ++q) yq[q] = SnConstRowMap<K>(y + static_cast<long>(c + q) * K);
+    for (int q = 0; q < B; ++q) yq[q] = sn_load<K>(y + static_cast<long>(c + q) * K);
     for (int a = 0; a < nr; ++a) {
-      SnRowMap<K> ta(t + static_cast<long>(a) * K);
-      SnRow<K> r = ta;
+      SnRow<K> r = sn_load<K>(t + static_cast<long>(a) * K);
       for (int q = 0; q < B; ++q) {
         if constexpr (Subtract)
           r -= p[q * ld + a] * yq[q];
         else
           r += p[q * ld + a] * yq[q];
       }
-      ta = r;
+      sn_store<K>(t + static_cast<long>(a) * K, r);
     }
   }
   for (; c < ncols; ++c) {
     const double* pc = P + c * ld;
-    const SnRow<K> yc = SnConstRowMap<K>(y + static_cast<long>(c) * K);
+    const SnRow<K> yc = sn_load<K>(y + static_cast<long>(c) * K);
     for (int a = 0; a < nr; ++a) {
+      SnRow<K> r = sn_load<K>(t + static_cast<long>(a) * K);
       if constexpr (Subtract)
-        SnRowMap<K>(t + static_cast<long>(a) * K) -= pc[a] * yc;
+        r -= pc[a] * yc;
       else
-        SnRowMap<K>(t + static_cast<long>(a) * K) += pc[a] * yc;
+        r += pc[a] * yc;
+      sn_store<K>(t + static_cast<long>(a) * K, r);
     }
   }
 }
@@ -650,16 +715,23 @@ void sn_panel_transpose_times(const double* P, long ld, int nr, int ncols, const
     SnRow<K> acc[B];
     for (int q = 0; q < B; ++q) acc[q].setZero();
     for (int a = 0; a < nr; ++a) {
-      const SnRow<K> ta = SnConstRowMap<K>(t + static_cast<long>(a) * K);
+      const SnRow<K> ta = sn_load<K>(t + static_cast<long>(a) * K);
       for (int q = 0; q < B; ++q) acc[q] += p[q * ld + a] * ta;
     }
-    for (int q = 0; q < B; ++q) SnRowMap<K>(y + static_cast<long>(c + q) * K) -= acc[q];
+    for (int q = 0; q < B; ++q) {
+      SnRow<K> r = sn_load<K>(y + static_cast<long>(c + q) * K);
+      r -= acc[q];
+      sn_store<K>(y + static_cast<long>(c + q) * K, r);
+    }
   }
   for (; c < ncols; ++c) {
     const double* pc = P + c * ld;
-    SnRow<K> acc = SnRow<K>::Zero();
-    for (int a = 0; a < nr; ++a) acc += pc[a] * SnConstRowMap<K>(t + static_cast<long>(a) * K);
-    SnRowMap<K>(y + static_cast<long>(c) * K) -= acc;
+    SnRow<K> acc;
+    acc.setZero();
+    for (int a = 0; a < nr; ++a) acc += pc[a] * sn_load<K>(t + static_cast<long>(a) * K);
+    SnRow<K> r = sn_load<K>(y + static_cast<long>(c) * K);
+    r -= acc;
+    sn_store<K>(y + static_cast<long>(c) * K, r);
   }
 }
 
@@ -674,9 +746,14 @@ void sn_diagonal_solve(const double* D, long ld, int ncols, double* y) {
     const int ce = std::min(cb + B, ncols);
     for (int c = cb; c < ce; ++c) {
       const double* dc = D + c * ld;
-      SnRowMap<K> yc(y + static_cast<long>(c) * K);
+      SnRow<K> yc = sn_load<K>(y + static_cast<long>(c) * K);
       yc /= dc[c];
-      for (int r = c + 1; r < ce; ++r) SnRowMap<K>(y + static_cast<long>(r) * K) -= dc[r] * yc;
+      sn_store<K>(y + static_cast<long>(c) * K, yc);
+      for (int r = c + 1; r < ce; ++r) {
+        SnRow<K> yr = sn_load<K>(y + static_cast<long>(r) * K);
+        yr -= dc[r] * yc;
+        sn_store<K>(y + static_cast<long>(r) * K, yr);
+      }
     }
     if (ce < ncols)
       sn_panel_update<K, true>(D + cb * ld + ce, ld, ncols - ce, ce - cb, y + static_cast<long>(cb) * K,
@@ -693,9 +770,10 @@ void sn_diagonal_transpose_solve(const double* D, long ld, int ncols, double* y)
                                   y + static_cast<long>(cb) * K);
     for (int c = ce - 1; c >= cb; --c) {
       const double* dc = D + c * ld;
-      SnRowMap<K> yc(y + static_cast<long>(c) * K);
-      for (int r = c + 1; r < ce; ++r) yc -= dc[r] * SnConstRowMap<K>(y + static_cast<long>(r) * K);
+      SnRow<K> yc = sn_load<K>(y + static_cast<long>(c) * K);
+      for (int r = c + 1; r < ce; ++r) yc -= dc[r] * sn_load<K>(y + static_cast<long>(r) * K);
       yc /= dc[c];
+      sn_store<K>(y + static_cast<long>(c) * K, yc);
     }
   }
 }
