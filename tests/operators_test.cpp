@@ -118,6 +118,15 @@ TEST(CotanStiffness, SameBitsAsTheTripletAssembly) {
     EXPECT_TRUE(std::equal(W.innerIndexPtr(), W.innerIndexPtr() + W.nonZeros(), R.innerIndexPtr()));
     EXPECT_EQ(std::memcmp(W.valuePtr(), R.valuePtr(), sizeof(double) * static_cast<size_t>(W.nonZeros())), 0);
   }
+  // Faces indexing outside V add nothing (instead of writing out of bounds).
+  const auto& [V, F] = meshes.back();
+  Eigen::MatrixXi Fbad = F;
+  Fbad.conservativeResize(F.rows() + 2, 3);
+  Fbad.row(F.rows()) << 0, 1, static_cast<int>(V.rows()) + 5;
+  Fbad.row(F.rows() + 1) << -1, 2, 3;
+  const SparseMatrix Wg = cotan_stiffness(V, F), Wb = cotan_stiffness(V, Fbad);
+  ASSERT_EQ(Wb.nonZeros(), Wg.nonZeros());
+  EXPECT_EQ(std::memcmp(Wb.valuePtr(), Wg.valuePtr(), sizeof(double) * static_cast<size_t>(Wg.nonZeros())), 0);
 }
 
 TEST(CotanStiffness, LinearFunctionsAreHarmonicInTheInteriorOfAPlane) {

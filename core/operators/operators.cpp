@@ -25,6 +25,7 @@ SparseMatrix cotan_stiffness(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F)
   std::vector<char> kept(static_cast<size_t>(nf), 0);
   for (int f = 0; f < nf; ++f) {
     const int idx[3] = {F(f, 0), F(f, 1), F(f, 2)};
+    if (std::min({idx[0], idx[1], idx[2]}) < 0 || std::max({idx[0], idx[1], idx[2]}) >= n) continue;  // not a face of V
     const Eigen::Vector3d p[3] = {row3(V, idx[0]), row3(V, idx[1]), row3(V, idx[2])};
     const double dbl_area = (p[1] - p[0]).cross(p[2] - p[0]).norm();
     if (!(dbl_area > 0) || !std::isfinite(dbl_area)) continue;

@@ -18,7 +18,7 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 
 // Cotangent stiffness matrix W (#V by #V), positive semi-definite. Each triangle adds
 // ½cot of its angle to the opposite edge. Degenerate triangles (zero area) contribute nothing
-// rather than Inf.
+// rather than Inf; so do faces with an index outside V.
 SparseMatrix cotan_stiffness(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
 
 enum class MassType {
