@@ -6,6 +6,8 @@
 
 #include <Eigen/Geometry>
 
+#include "mesh/topology.h"
+
 namespace mm {
 
 namespace {
@@ -36,43 +38,30 @@ SparseMatrix cotan_stiffness(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F)
       half_cot[3 * static_cast<size_t>(f) + c] = 0.5 * u.dot(v) / dbl_area;
     }
   }
-  // The kept faces of each vertex, ascending.
-  std::vector<int> start(static_cast<size_t>(n) + 1, 0), faces;
-  for (int f = 0; f < nf; ++f)
-    if (kept[f])
-      for (int c = 0; c < 3; ++c) ++start[static_cast<size_t>(F(f, c)) + 1];
-  for (int v = 0; v < n; ++v) start[v + 1] += start[v];
-  faces.resize(static_cast<size_t>(start[n]));
-  {
-    std::vector<int> fill(start.begin(), start.end() - 1);
-    for (int f = 0; f < nf; ++f)
-      if (kept[f])
-        for (int c = 0; c < 3; ++c) faces[static_cast<size_t>(fill[F(f, c)]++)] = f;
-  }
-  // Column v: v and its neighbours through kept faces (each kept face puts two neighbours and v).
+  // The kept faces of each vertex, ascending (corners bucketed by their vertex, in corner order).
+  const VertexBuckets corners = bucket_by_vertex(n, 3 * nf, [&](int h) { return kept[h / 3] ? F(h / 3, h % 3) : -1; });
+  // Column v: v and its neighbours through kept faces (collected with a stamp, sorted), then
+  // the face terms added at their rows' slots.
   std::vector<int> outer(static_cast<size_t>(n) + 1, 0), inner, stamp(static_cast<size_t>(n), -1), slot(static_cast<size_t>(n), 0);
   std::vector<double> values;
-  inner.reserve(faces.size() + static_cast<size_t>(n));
+  inner.reserve(corners.items.size() + static_cast<size_t>(n));
+  values.reserve(inner.capacity());
   for (int v = 0; v < n; ++v) {
-    const size_t first = inner.size();
-    for (int k = start[v]; k < start[v + 1]; ++k) {
-      const int f = faces[static_cast<size_t>(k)];
+    const int first = outer[v];
+    for (int k = corners.start[v]; k < corners.start[v + 1]; ++k)
       for (int c = 0; c < 3; ++c) {
-        const int w = F(f, c);
+        const int w = F(corners.items[k] / 3, c);
         if (stamp[w] != v) {
           stamp[w] = v;
           inner.push_back(w);
         }
       }
-    }
-    std::sort(inner.begin() + static_cast<std::ptrdiff_t>(first), inner.end());
+    std::sort(inner.begin() + first, inner.end());
     outer[v + 1] = static_cast<int>(inner.size());
-  }
-  values.assign(inner.size(), -0.0);
-  for (int v = 0; v < n; ++v) {
-    for (int k = outer[v]; k < outer[v + 1]; ++k) slot[inner[static_cast<size_t>(k)]] = k;
-    for (int k = start[v]; k < start[v + 1]; ++k) {
-      const int f = faces[static_cast<size_t>(k)];
+    values.resize(inner.size(), -0.0);
+    for (int k = first; k < outer[v + 1]; ++k) slot[inner[static_cast<size_t>(k)]] = k;
+    for (int k = corners.start[v]; k < corners.start[v + 1]; ++k) {
+      const int f = corners.items[k] / 3;
       for (int c = 0; c < 3; ++c) {
         const int i = F(f, (c + 1) % 3), j = F(f, (c + 2) % 3);
         if (i != v && j != v) continue;
