@@ -264,7 +264,7 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     for (int j = 0; j < n; ++j) parent[q[j]] = parent0[j] < 0 ? -1 : q[parent0[j]];
   }
   const SnSparse C = sn_permuted_triangle(A, perm_, false);
-  if (!progress.update("factor: analysis", 0.5)) return cancelled_status("factor");
+  if (!progress.update("factor: analysis", 0.05)) return cancelled_status("factor");  // analysis: 0..0.1
 
   // ---- column counts of L (off-diagonal) on the postordered tree (the identity is its postorder).
   const std::vector<int> cc = sn_column_counts(C, parent);
@@ -341,7 +341,7 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
   }
   values_size_ = value_ptr_.back();
   values_.reset(new double[static_cast<size_t>(values_size_)]);
-  if (!progress.update("factor: analysis", 1.0)) return cancelled_status("factor");
+  if (!progress.update("factor: analysis", 0.1)) return cancelled_status("factor");
 
   // ---- numeric multifrontal factorization in sn_postorder. Each supernode's update matrix waits
   // in its own slot until the parent assembles it (children in reverse order, as a stack would
@@ -516,7 +516,7 @@ Status SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& A, const Pr
     done_flops += flops_of(s);
     if (done_flops - reported > 0.02 * total_flops) {
       reported = done_flops;
-      if (!progress.update("factor", done_flops / total_flops)) return cancelled_status("factor");
+      if (!progress.update("factor", 0.1 + 0.9 * done_flops / total_flops)) return cancelled_status("factor");
     }
   }
   // Relative pivot check, as SpdSolver does: a tiny pivot means a numerically singular matrix.
