@@ -500,6 +500,18 @@ TEST(JointFitting, SelfFitEveryCharacter) {
   }
 }
 
+// The page's progress bar: the fit's fractions (both skeletons, match, place) only move forward.
+TEST(JointFitting, ProgressOnlyMovesForward) {
+  const JfCharacter s = jf_character("anim/CesiumMan/CesiumMan.glb");
+  const mm::io::LoadResult t = mm::io::load_asset(mm::test::data_path("anim/human_woman.ply"));
+  ASSERT_TRUE(t.status.ok());
+  mm::test::ForwardProgress fp;
+  const mm::JointFitResult fit = mm::fit_joints(s.c.V_rest, s.c.F, s.joints, t.asset.V_raw, t.asset.F_raw, {}, {}, fp.sink());
+  ASSERT_TRUE(fit.status.ok()) << fit.status.message;
+  EXPECT_GE(fp.reports, 4);
+  EXPECT_TRUE(fp.backwards.empty()) << fp.backwards.front();
+}
+
 TEST(JointFitting, StaticMeshesAgainstHandPlacedJoints) {
   // Issue 14 asks for 4 % of the height. Woman: 3.5 % (her thighs touch, so her curve skeleton
   // forks at the knees; the split up to the crotch (step 4b) took her from 5.9 % to 4.5 %, and

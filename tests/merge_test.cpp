@@ -412,6 +412,16 @@ TEST(MergeJob, WritesGlbKeepingTheTargetDocumentAndMatchesGolden) {
   test::expect_golden("merge_head_on_neck_sample", sample, 1e-8 * bounding_box_diagonal(direct.V));
 }
 
+// The page's progress bar: the merge's fractions only move forward and end at 1.
+TEST(Merge, ProgressOnlyMovesForward) {
+  test::ForwardProgress fp;
+  const MergeResult r = merge_meshes(head_on_neck(), {}, fp.sink());
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
+  EXPECT_GE(fp.reports, 4);
+  EXPECT_TRUE(fp.backwards.empty()) << fp.backwards.front();
+  EXPECT_NEAR(fp.last, 1.0, 1e-12);
+}
+
 }  // namespace
 }  // namespace mm
 

@@ -258,7 +258,8 @@ struct Job {
 std::unique_ptr<Job> job(const std::string& src, const std::string& tgt, const std::string& clip, double fps,
                          int last_frame, const std::string& joints_file = "",
                          mm::app::RetargetMethod method = mm::app::RetargetMethod::Harmonic,
-                         const std::function<void(mm::HarmonicRetargetOptions&)>& tweak = {}) {
+                         const std::function<void(mm::HarmonicRetargetOptions&)>& tweak = {},
+                         const mm::Progress& progress = {}) {
   auto j = std::make_unique<Job>();
   j->src = mm::io::load_asset(mm::test::data_path(src));
   j->tgt = mm::io::load_asset(mm::test::data_path(tgt));
@@ -279,7 +280,7 @@ std::unique_ptr<Job> job(const std::string& src, const std::string& tgt, const s
   o.last_frame = last_frame;
   o.method = method;
   if (tweak) tweak(o.harmonic);
-  j->status = j->session.prepare(j->src.asset, j->tgt.asset, joints, "", o);
+  j->status = j->session.prepare(j->src.asset, j->tgt.asset, joints, "", o, progress);
   return j;
 }
 
@@ -449,6 +450,21 @@ TEST(RetargetReal, FoxToWolfWithPlacedJoints) {
   // articulated base on the Fox's skin weights, 0.016 with learned weights.
   EXPECT_LE(be.mean, 0.029);
   EXPECT_LT(be.max, 0.3);
+}
+
+// The page's progress bar: the precompute's fractions (maps, sampling, SVD, factor) and then the
+// frames' only move forward.
+TEST(RetargetReal, ProgressOnlyMovesForward) {
+  mm::test::ForwardProgress fp;
+  auto j = job("anim/Fox/glTF-Binary/Fox.glb", "anim/wolf0.ply", "Walk", 15, 3, "joints/wolf0_joints.json",
+               mm::app::RetargetMethod::Harmonic, {}, fp.sink());
+  ASSERT_TRUE(j->status.ok()) << j->status.message;
+  EXPECT_GE(fp.reports, 4);
+  EXPECT_TRUE(fp.backwards.empty()) << fp.backwards.front();
+  mm::test::ForwardProgress frames_fp;
+  std::vector<Eigen::MatrixXd> frames;
+  ASSERT_TRUE(j->session.frames(0, 3, &frames, frames_fp.sink()).ok());
+  EXPECT_TRUE(frames_fp.backwards.empty()) << frames_fp.backwards.front();
 }
 
 TEST(RetargetReal, MultiPartRobotExpressive) {

@@ -188,4 +188,23 @@ TEST(SpectralBasis, CancelStopsTheSolver) {
   EXPECT_EQ(calls, 5);
 }
 
+// The page's progress bar: both solvers' fractions only move forward, on a mesh that needs a second
+// pass (the icosphere's multiplets at k = 6 and 15) as on one that does not.
+TEST(SpectralBasis, ProgressOnlyMovesForward) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  test::icosphere(4, &V, &F);
+  for (const EigenSolverKind solver : {EigenSolverKind::Spectra, EigenSolverKind::BlockLanczos})
+    for (const int k : {6, 15, 20}) {
+      test::ForwardProgress fp;
+      SpectralBasisOptions opt;
+      opt.k = k;
+      opt.solver = solver;
+      const SpectralBasis b = spectral_basis(V, F, opt, fp.sink());
+      ASSERT_TRUE(b.status.ok()) << b.status.message;
+      EXPECT_GE(fp.reports, 2) << k;
+      EXPECT_TRUE(fp.backwards.empty()) << b.solver << " k = " << k << ", " << b.passes << " passes: " << fp.backwards.front();
+    }
+}
+
 }  // namespace mm

@@ -88,4 +88,15 @@ std::string data_uri(const std::vector<uint8_t>& data) {
   return out;
 }
 
+Progress ForwardProgress::sink() {
+  return Progress([this](const std::string& stage, double f) {
+    const std::string previous = stages.empty() ? "" : stages.back();
+    if (f < last - 1e-12) backwards.push_back(previous + " at " + std::to_string(last) + " -> " + stage + " at " + std::to_string(f));
+    if (stages.empty() || stages.back() != stage) stages.push_back(stage);
+    last = f;
+    ++reports;
+    return true;
+  });
+}
+
 }  // namespace mm::test

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include "common/progress.h"
 #include "mesh/mesh.h"
 
 namespace mm::test {
@@ -33,5 +34,15 @@ bool update_golden();
 // tolerance stored in the file. With --update-golden, writes the file instead (storing
 // `tolerance`) and passes. The JSON holds {"tolerance", "rows", "cols", "data": row-major}.
 void expect_golden(const std::string& name, const Eigen::MatrixXd& values, double tolerance);
+
+// A progress sink that records every report and whether the fraction ever went back (the page's
+// bar follows these fractions). It never cancels.
+struct ForwardProgress {
+  std::vector<std::string> stages;  // consecutive duplicates collapsed
+  std::vector<std::string> backwards;  // "stage a at f → stage b at g" for each step back
+  double last = 0;
+  int reports = 0;
+  Progress sink();
+};
 
 }  // namespace mm::test

@@ -129,8 +129,12 @@ LanczosRun run_spectra(ShiftInvertLdlt& op, const Eigen::SparseMatrix<double>& A
 
 // Shift-invert in symmetric form: with D = A^½ and y = D φ, the pairs are the largest θ of
 // D (W - σA)⁻¹ D y = θ y, λ = σ + 1/θ (W - σA is SPD for σ < 0: one supernodal Cholesky).
+// expected: the operator applications the progress fraction 1 − exp(−applications / expected)
+// is scaled to, the same for every pass (applications accumulate over the passes, so a later
+// pass's larger nev must not lower it: the bar went back at each second pass).
 LanczosRun run_block(const SupernodalCholesky& chol, const Eigen::VectorXd& d, int nev, int block,
-                     const SpectralBasisOptions& opt, const Progress& progress, double sigma, int* applications) {
+                     const SpectralBasisOptions& opt, const Progress& progress, double sigma, double expected,
+                     int* applications) {
   LanczosRun run;
   const int n = static_cast<int>(d.size());
   BlockLanczosOptions bo;
@@ -139,7 +143,6 @@ LanczosRun run_block(const SupernodalCholesky& chol, const Eigen::VectorXd& d, i
   bo.max_dim = opt.ncv;
   bo.tolerance = opt.tolerance;
   bo.max_restarts = opt.max_iterations;
-  const double expected = 3.0 * std::max(2 * nev + 1, nev + 20);
   const BlockLanczosResult r = block_lanczos(
       n,
       [&](const Eigen::MatrixXd& X, Eigen::MatrixXd* Y) {
@@ -265,7 +268,8 @@ SpectralBasis spectral_basis(const Eigen::SparseMatrix<double>& W, const Eigen::
     Eigen::VectorXd sorted;
     for (int pass = 0;; ++pass) {
       LanczosRun run = spectra ? run_spectra(op, A, n, nev, sigma, opt)
-                               : run_block(chol, d, nev, block, opt, progress.sub(0.05, 1.0), sigma, &applications);
+                               : run_block(chol, d, nev, block, opt, progress.sub(0.05, 1.0), sigma,
+                                           3.0 * std::max(2 * opt.k + 1, opt.k + 20), &applications);
       out.iterations += run.iterations;
       if (!run.status.ok()) {
         out.status = run.status;
