@@ -280,4 +280,11 @@ TEST(TransferProgress, ReportsStagesAndCancels) {
   EXPECT_TRUE(parse_transfer_method("kovnatsky", &m));
   EXPECT_EQ(m, TransferMethod::Kovnatsky);
   EXPECT_FALSE(parse_transfer_method("sumner", &m));
+  // A whole transfer (cage, optimisation, fold and flip checks): the bar only moves forward.
+  test::ForwardProgress fp;
+  const Mesh cat = transfer_test::load("pose/cat-01.ply");
+  r = pose_transfer(cat, lion, transfer_test::load_pairs("landmarks/cat-lion.json"), {}, fp.sink());
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
+  EXPECT_TRUE(fp.backwards.empty()) << fp.backwards.front();
+  EXPECT_GE(fp.reports, 10);
 }
