@@ -243,7 +243,10 @@ SpectralBasis spectral_basis(const Eigen::SparseMatrix<double>& W, const Eigen::
     out.passes = 1;
     out.solver = "dense";
   } else {
-    ShiftInvertLdlt op(W, A, progress, 3 * std::min(n, std::max(2 * opt.k + 1, opt.k + 20)));
+    // Operator applications the progress fraction is scaled to, by k (not by a pass's nev), for
+    // both solvers.
+    const int expected_ops = 3 * std::min(n, std::max(2 * opt.k + 1, opt.k + 20));
+    ShiftInvertLdlt op(W, A, progress, expected_ops);
     SupernodalCholesky chol;
     if (!spectra) {
       const Eigen::SparseMatrix<double> M = W - sigma * A;
@@ -269,7 +272,7 @@ SpectralBasis spectral_basis(const Eigen::SparseMatrix<double>& W, const Eigen::
     for (int pass = 0;; ++pass) {
       LanczosRun run = spectra ? run_spectra(op, A, n, nev, sigma, opt)
                                : run_block(chol, d, nev, block, opt, progress.sub(0.05, 1.0), sigma,
-                                           3.0 * std::max(2 * opt.k + 1, opt.k + 20), &applications);
+                                           expected_ops, &applications);
       out.iterations += run.iterations;
       if (!run.status.ok()) {
         out.status = run.status;
