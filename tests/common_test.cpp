@@ -54,6 +54,24 @@ TEST(Progress, SubRangesMapIntoParentAndShareCancel) {
   EXPECT_EQ(cancelled_status("factor").code, StatusCode::Cancelled);
 }
 
+TEST(Progress, SubRangeWithAStageReportsItsNameForEveryCallee) {
+  std::vector<std::string> names;
+  std::vector<double> seen;
+  Progress p([&](const std::string& stage, double f) {
+    names.push_back(stage);
+    seen.push_back(f);
+    return true;
+  });
+  const Progress named = p.sub(0.0, 0.5, "eigenbasis");
+  named.update("factor: analysis", 0.5);
+  named.sub(0.5, 1.0).update("factor", 1.0);  // a sub-range of it keeps the name
+  p.update("factor", 1.0);                     // the parent is not renamed
+  EXPECT_EQ(names, (std::vector<std::string>{"eigenbasis", "eigenbasis", "factor"}));
+  ASSERT_EQ(seen.size(), 3u);
+  EXPECT_NEAR(seen[0], 0.25, 1e-12);
+  EXPECT_NEAR(seen[1], 0.5, 1e-12);
+}
+
 TEST(Progress, FractionIsClamped) {
   double last = -1;
   Progress p([&](const std::string&, double f) {

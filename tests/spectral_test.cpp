@@ -204,6 +204,8 @@ TEST(SpectralBasis, ProgressOnlyMovesForward) {
       ASSERT_TRUE(b.status.ok()) << b.status.message;
       EXPECT_GE(fp.reports, 2) << k;
       EXPECT_TRUE(fp.backwards.empty()) << b.solver << " k = " << k << ", " << b.passes << " passes: " << fp.backwards.front();
+      // The page's bar names the job's stage, not the factorisation's inside it.
+      EXPECT_EQ(fp.stages, std::vector<std::string>{"eigenbasis"}) << b.solver << " k = " << k;
     }
 }
 

@@ -13,7 +13,7 @@ bool Progress::update(const std::string& stage, double fraction) const {
   if (state_->cancelled.load()) return false;
   if (state_->callback) {
     const double f = begin_ + (end_ - begin_) * std::clamp(fraction, 0.0, 1.0);
-    if (!state_->callback(stage, f)) state_->cancelled.store(true);
+    if (!state_->callback(stage_.empty() ? stage : stage_, f)) state_->cancelled.store(true);
   }
   return !state_->cancelled.load();
 }
@@ -22,6 +22,12 @@ Progress Progress::sub(double begin, double end) const {
   Progress p = *this;
   p.begin_ = begin_ + (end_ - begin_) * begin;
   p.end_ = begin_ + (end_ - begin_) * end;
+  return p;
+}
+
+Progress Progress::sub(double begin, double end, std::string stage) const {
+  Progress p = sub(begin, end);
+  p.stage_ = std::move(stage);
   return p;
 }
 

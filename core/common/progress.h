@@ -36,6 +36,9 @@ class Progress {
 
   // A sink whose 0..1 maps to [begin, end] of this one (both in 0..1 of this sub-range).
   Progress sub(double begin, double end) const;
+  // The same, and every update through it is reported as `stage` whatever the callee names it
+  // (a library step such as a factorisation shows under its caller's name on the page's bar).
+  Progress sub(double begin, double end, std::string stage) const;
 
  private:
   struct State {
@@ -45,6 +48,7 @@ class Progress {
   std::shared_ptr<State> state_;
   double begin_ = 0.0;
   double end_ = 1.0;
+  std::string stage_;  // non-empty: reported instead of the callee's stage name
 };
 
 // The Status a computation returns when its progress sink asked it to stop during `stage`.

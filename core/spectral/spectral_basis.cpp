@@ -250,7 +250,7 @@ SpectralBasis spectral_basis(const Eigen::SparseMatrix<double>& W, const Eigen::
     SupernodalCholesky chol;
     if (!spectra) {
       const Eigen::SparseMatrix<double> M = W - sigma * A;
-      const Status fs = chol.factor(M, progress.sub(0.0, 0.05));
+      const Status fs = chol.factor(M, progress.sub(0.0, 0.05, "eigenbasis"));
 
       if (!fs.ok()) {
         out.status = fs.code == StatusCode::Cancelled
