@@ -441,7 +441,8 @@ TEST(PartTransferDifferent, CatToLionHorseToCamelMichaelToArmadillo) {
 }
 
 // The sets of a round run side by side on the thread pool (part_transfer.cpp): one thread and
-// two give the same result, bit for bit, and the same reports in the same order. Natively only
+// two give the same result, bit for bit, and the same reports in the same order, and their progress
+// only moves forward. Natively only
 // (the single-threaded wasm build has one thread; tests/js/threads.test.mjs runs this on the
 // threaded build). One round of three sets of at most three parts keeps it short.
 TEST(PartTransferThreads, SetsSideBySideEqualOneThread) {
@@ -452,13 +453,20 @@ TEST(PartTransferThreads, SetsSideBySideEqualOneThread) {
   PartTransferOptions o;
   o.max_parts = 3;
   o.proposal_rounds = 1;
+  // The bar only moves forward on either thread count: with sets on the pool only the calling
+  // thread reports (the sets' own progress, `shown`, is polled while it waits).
+  test::ForwardProgress fp_one, fp_two;
   set_max_threads(1);
-  const PartTransferResult one = part_transfer(P, S, {}, nullptr, o);
+  const PartTransferResult one = part_transfer(P, S, {}, nullptr, o, fp_one.sink());
   set_max_threads(2);
-  const PartTransferResult two = part_transfer(P, S, {}, nullptr, o);
+  const PartTransferResult two = part_transfer(P, S, {}, nullptr, o, fp_two.sink());
   set_max_threads(0);
   ASSERT_TRUE(one.status.ok()) << one.status.message;
   ASSERT_TRUE(two.status.ok()) << two.status.message;
+  EXPECT_TRUE(fp_one.backwards.empty()) << fp_one.backwards.front();
+  EXPECT_TRUE(fp_two.backwards.empty()) << fp_two.backwards.front();
+  EXPECT_GE(fp_one.reports, 10);
+  EXPECT_GE(fp_two.reports, 10);
   EXPECT_GE(one.proposals_tried, 2);
   EXPECT_TRUE(one.V == two.V) << "one thread and two differ";
   ASSERT_EQ(one.reports.size(), two.reports.size());
