@@ -441,10 +441,10 @@ TEST(PartTransferDifferent, CatToLionHorseToCamelMichaelToArmadillo) {
 }
 
 // The sets of a round run side by side on the thread pool (part_transfer.cpp): one thread and
-// two give the same result, bit for bit, and the same reports in the same order, and their progress
-// only moves forward. Natively only
-// (the single-threaded wasm build has one thread; tests/js/threads.test.mjs runs this on the
-// threaded build). One round of three sets of at most three parts keeps it short.
+// two give the same result, bit for bit, the same reports in the same order, and progress that
+// only moves forward. Natively only (the single-threaded wasm build has one thread;
+// tests/js/threads.test.mjs runs this on the threaded build). One round of three sets of at most
+// three parts keeps it short.
 TEST(PartTransferThreads, SetsSideBySideEqualOneThread) {
 #ifdef __EMSCRIPTEN__
   GTEST_SKIP() << "one thread in this build";
