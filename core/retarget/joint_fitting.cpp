@@ -656,14 +656,28 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     // of a thin axis too (human_woman's back, 0.18 of her height deep, held 3 ends within 0.12 of
     // its extent at some grid resolutions, and won the vote as up = −z). A quadruped stands
     // 0.5–0.6 of its length tall (wolf0 0.53).
+    // A limb end counts as on the ground as in step 4 (below ground_band and within ground_step of
+    // the lowest end), and a tie goes to the end the solid stands on more broadly (solid cells in
+    // its lowest 3 %): the Stanford armadillo's two ear tips and raised hand lie as low along −y as
+    // its two feet along +y (3 ends to 2 by the band alone, and it was fitted upside down; 111 % bone
+    // disagreement), but its soles are flat.
     const Eigen::Vector3d extent = (Vt.colwise().maxCoeff() - Vt.colwise().minCoeff()).transpose();
-    int best = -1;
+    const Eigen::MatrixXd cells = jf_solid_samples(TS.volume, 20000);
+    int best = -1, best_support = -1;
     for (int a : {1, 2, 0, 4, 5, 3}) {
       if (extent[a % 3] < opt.min_up_extent * extent.maxCoeff()) continue;
       const JfFrame f = jf_frame(Vt, jf_axis(a));
+      double lowest = std::numeric_limits<double>::infinity();
+      for (int i = 0; i < Lt.rows(); ++i) lowest = std::min(lowest, f.height(Lt.row(i).transpose()));
       int n = 0;
-      for (int i = 0; i < Lt.rows(); ++i) n += f.height(Lt.row(i).transpose()) < opt.ground_band;
-      if (n > best) best = n, up_t = a;
+      for (int i = 0; i < Lt.rows(); ++i) {
+        const double h = f.height(Lt.row(i).transpose());
+        n += h < opt.ground_band && h <= lowest + opt.ground_step;
+      }
+      if (n < best) continue;
+      int support = 0;
+      for (int i = 0; i < cells.rows(); ++i) support += f.height(cells.row(i).transpose()) < 0.03;
+      if (n > best || support > best_support) best = n, best_support = support, up_t = a;
     }
   }
   r.target_up = up_t;
@@ -1068,7 +1082,11 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     if (n == 0) continue;  // cannot happen: e lies on some matched path
     const Eigen::Vector3d qt = sum / n;
     const double rt = rsum / n;
-    const double scale = std::clamp(rq > 0 ? rt / rq : 1.0, 0.25, 4.0);
+    // The radii's ratio, clamped relative to the heights' ratio: the two files may use any units (a
+    // Fox ~100 units tall, Sumner's cat 0.38), and the clamp bounds how much thicker or thinner the
+    // target's limb may be than the source's once both are the same height.
+    const double hs = ft.H / fs.H;
+    const double scale = hs * std::clamp(rq > 0 ? rt / (rq * hs) : 1.0, 0.25, 4.0);
     carried[j].ok = true;
     carried[j].qt = qt;
     carried[j].off = R.transpose() * (pj - q) * scale;
