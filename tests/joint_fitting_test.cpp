@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdlib>
 #include <cmath>
@@ -627,69 +628,6 @@ TEST(JointFitting, SumnersAnimalsAndTheArmadilloFitRightWayRound) {
   EXPECT_LT(height("Skeleton_torso_joint_1"), height("Skeleton_neck_joint_1"));
 }
 
-// Why Fox → wolf0 stays above issue 14's 4 % (forty-fifth session): the hand-placed wolf joints
-// read the Fox's joint names anatomically, not as the Fox's rig places them. Each hand-placed joint
-// is moved, inside the wolf's own cross-sections through it (vertical and sideways), to the
-// fractions at which the Fox's rig puts that joint inside the Fox's (a vertical ray through the
-// joint: 0 at the surface below, 1 above). Its position along the body is left as hand-placed. The
-// mean move is what a fit that carries the Fox's rig faithfully must differ from the reference by
-// in those two directions alone: 4.8 % of the height, above the bound before any other error. The
-// fit itself follows the Fox there: its hip and upper arms lie nearer the Fox's fractions than the
-// reference's.
-TEST(JointFitting, WolfReferenceReadsTheFoxsJointsAnotherWay) {
-  const JfCharacter fox = jf_character("anim/Fox/glTF-Binary/Fox.glb");
-  const mm::io::LoadResult wolf = mm::io::load_asset(mm::test::data_path("anim/wolf0.ply"));
-  ASSERT_TRUE(wolf.status.ok());
-  const mm::io::JointSetResult hand = mm::io::parse_joints_json(jf_read("joints/wolf0_joints.json"));
-  ASSERT_TRUE(hand.status.ok());
-  const mm::JointFitResult fit = mm::fit_joints(fox.c.V_rest, fox.c.F, fox.joints, wolf.asset.V_raw, wolf.asset.F_raw);
-  ASSERT_TRUE(fit.status.ok()) << fit.status.message;
-  const mm::TriangleBvh fox_bvh(fox.c.V_rest, fox.c.F), wolf_bvh(wolf.asset.V_raw, wolf.asset.F_raw);
-  // The surface interval through p along ±axis, and p's fraction in it (NaN when a ray escapes).
-  auto fraction = [](const mm::TriangleBvh& bvh, const Eigen::Vector3d& p, const Eigen::Vector3d& axis, Eigen::Vector2d* span) {
-    const double below = bvh.ray_first_hit(p, -axis), above = bvh.ray_first_hit(p, axis);
-    if (!std::isfinite(below) || !std::isfinite(above)) return std::nan("");
-    if (span) *span = {-below, above};
-    return below / (below + above);
-  };
-  // Source axes (glTF: +Y up, X sideways) and the same directions in the wolf's file (rotation:
-  // target axes → source axes).
-  const Eigen::Vector3d up_s = Eigen::Vector3d::UnitY(), side_s = Eigen::Vector3d::UnitX();
-  const Eigen::Vector3d up_t = fit.rotation.transpose() * up_s, side_t = fit.rotation.transpose() * side_s;
-  const double H = jf_extent(wolf.asset.V_raw, fit.target_up % 3);
-  double floor_sum = 0;
-  int n = 0;
-  std::map<std::string, std::array<double, 3>> vertical;  // Fox, hand-placed, fit
-  for (int j = 0; j < hand.joints.size(); ++j) {
-    const std::string& name = hand.joints.names[j];
-    const int s = fox.joints.find(name), f = fit.joints.find(name);
-    ASSERT_GE(s, 0) << name;
-    ASSERT_GE(f, 0) << name;
-    const Eigen::Vector3d ps = fox.joints.P.row(s).transpose(), ph = hand.joints.P.row(j).transpose();
-    Eigen::Vector3d oracle = ph;
-    for (const auto& [as, at] : {std::pair{up_s, up_t}, std::pair{side_s, side_t}}) {
-      Eigen::Vector2d span;
-      const double fs = fraction(fox_bvh, ps, as, nullptr), fh = fraction(wolf_bvh, ph, at, &span);
-      ASSERT_TRUE(std::isfinite(fs) && std::isfinite(fh)) << name;
-      oracle += (span[0] + fs * (span[1] - span[0])) * at;
-      if (as == up_s) vertical[name] = {fs, fh, fraction(wolf_bvh, fit.joints.P.row(f).transpose(), at, nullptr)};
-    }
-    floor_sum += (oracle - ph).norm() / H;
-    ++n;
-  }
-  const double floor = floor_sum / n;
-  std::cout << "[ Fox's rig read into the wolf's cross-sections against the hand-placed joints ] mean " << floor
-            << " of the height over " << n << " joints\n";
-  for (const auto& [name, v] : vertical)
-    std::cout << "    " << name << " vertical: Fox " << v[0] << ", hand-placed " << v[1] << ", fit " << v[2] << "\n";
-  EXPECT_GT(floor, 0.04) << "the 4 % bound is within reach of a fit that follows the Fox's rig";
-  for (const char* name : {"b_Hip_01", "b_LeftUpperArm_09", "b_RightUpperArm_06"}) {
-    const auto& v = vertical.at(name);
-    EXPECT_GT(std::abs(v[0] - v[1]), 0.3) << name << ": the conventions differ by less than measured";
-    EXPECT_LT(std::abs(v[2] - v[0]), std::abs(v[2] - v[1])) << name << ": the fit does not follow the Fox's rig";
-  }
-}
-
 // The fit at other grid resolutions (twenty-eighth session). At 104 cells the woman's up axis
 // used to be detected as −z (three limb ends near her back, an axis 0.18 of her height deep) and
 // the fit was refused; a detected up axis must now span ≥ 0.3 of the longest extent. A broken fit
@@ -1085,6 +1023,91 @@ TEST(JointFittingRetarget, StaticTargetsBoneLengthsNoWorseThanHandPlaced) {
               << " / " << autoj->session.harmonic().bones().size() << " bones)\n";
     EXPECT_LE(ba.mean, bh.mean * 1.05 + 1e-3) << c.target;
   }
+}
+
+// Why Fox → wolf0 stays above issue 14's 4 % (forty-fifth session): the hand-placed wolf joints
+// read the Fox's joint names anatomically, not as the Fox's rig places them. Each hand-placed joint
+// is moved, inside the wolf's own cross-sections through it (vertical and sideways), to the
+// fractions at which the Fox's rig puts that joint inside the Fox's (a vertical ray through the
+// joint: 0 at the surface below, 1 above). Its position along the body is left as hand-placed. The
+// mean move is what a fit that carries the Fox's rig faithfully must differ from the reference by
+// in those two directions alone: 4.8 % of the height, above the bound before any other error. The
+// fit itself follows the Fox there: its hip and upper arms lie nearer the Fox's fractions than the
+// reference's. The same moved joints also explain most of why the retargeted clip's bones keep
+// their lengths better with the reference (issue 14's "not worse than hand-placed"): bone-length
+// error 0.00953 with the reference, 0.01019 with the reference moved to the Fox's fractions, 0.01034
+// with the automatic joints.
+TEST(JointFittingRetarget, WolfReferenceReadsTheFoxsJointsAnotherWay) {
+  const JfCharacter fox = jf_character("anim/Fox/glTF-Binary/Fox.glb");
+  const mm::io::LoadResult wolf = mm::io::load_asset(mm::test::data_path("anim/wolf0.ply"));
+  ASSERT_TRUE(wolf.status.ok());
+  const mm::io::JointSetResult hand = mm::io::parse_joints_json(jf_read("joints/wolf0_joints.json"));
+  ASSERT_TRUE(hand.status.ok());
+  const mm::JointFitResult fit = mm::fit_joints(fox.c.V_rest, fox.c.F, fox.joints, wolf.asset.V_raw, wolf.asset.F_raw);
+  ASSERT_TRUE(fit.status.ok()) << fit.status.message;
+  const mm::TriangleBvh fox_bvh(fox.c.V_rest, fox.c.F), wolf_bvh(wolf.asset.V_raw, wolf.asset.F_raw);
+  // The surface interval through p along ±axis, and p's fraction in it (NaN when a ray escapes).
+  auto fraction = [](const mm::TriangleBvh& bvh, const Eigen::Vector3d& p, const Eigen::Vector3d& axis, Eigen::Vector2d* span) {
+    const double below = bvh.ray_first_hit(p, -axis), above = bvh.ray_first_hit(p, axis);
+    if (!std::isfinite(below) || !std::isfinite(above)) return std::nan("");
+    if (span) *span = {-below, above};
+    return below / (below + above);
+  };
+  // Source axes (glTF: +Y up, X sideways) and the same directions in the wolf's file (rotation:
+  // target axes → source axes).
+  const Eigen::Vector3d up_s = Eigen::Vector3d::UnitY(), side_s = Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d up_t = fit.rotation.transpose() * up_s, side_t = fit.rotation.transpose() * side_s;
+  const double H = jf_extent(wolf.asset.V_raw, fit.target_up % 3);
+  double floor_sum = 0;
+  int n = 0;
+  std::map<std::string, std::array<double, 3>> vertical;  // Fox, hand-placed, fit
+  mm::JointSet moved = hand.joints;  // the reference at the Fox's fractions
+  for (int j = 0; j < hand.joints.size(); ++j) {
+    const std::string& name = hand.joints.names[j];
+    const int s = fox.joints.find(name), f = fit.joints.find(name);
+    ASSERT_GE(s, 0) << name;
+    ASSERT_GE(f, 0) << name;
+    const Eigen::Vector3d ps = fox.joints.P.row(s).transpose(), ph = hand.joints.P.row(j).transpose();
+    Eigen::Vector3d oracle = ph;
+    for (const auto& [as, at] : {std::pair{up_s, up_t}, std::pair{side_s, side_t}}) {
+      Eigen::Vector2d span;
+      const double fs = fraction(fox_bvh, ps, as, nullptr), fh = fraction(wolf_bvh, ph, at, &span);
+      ASSERT_TRUE(std::isfinite(fs) && std::isfinite(fh)) << name;
+      oracle += (span[0] + fs * (span[1] - span[0])) * at;
+      if (as == up_s) vertical[name] = {fs, fh, fraction(wolf_bvh, fit.joints.P.row(f).transpose(), at, nullptr)};
+    }
+    moved.P.row(j) = oracle.transpose();
+    floor_sum += (oracle - ph).norm() / H;
+    ++n;
+  }
+  const double floor = floor_sum / n;
+  std::cout << "[ Fox's rig read into the wolf's cross-sections against the hand-placed joints ] mean " << floor
+            << " of the height over " << n << " joints\n";
+  for (const auto& [name, v] : vertical)
+    std::cout << "    " << name << " vertical: Fox " << v[0] << ", hand-placed " << v[1] << ", fit " << v[2] << "\n";
+  EXPECT_GT(floor, 0.04) << "the 4 % bound is within reach of a fit that follows the Fox's rig";
+  for (const char* name : {"b_Hip_01", "b_LeftUpperArm_09", "b_RightUpperArm_06"}) {
+    const auto& v = vertical.at(name);
+    EXPECT_GT(std::abs(v[0] - v[1]), 0.3) << name << ": the conventions differ by less than measured";
+    EXPECT_LT(std::abs(v[2] - v[0]), std::abs(v[2] - v[1])) << name << ": the fit does not follow the Fox's rig";
+  }
+  // The Fox's Walk retargeted with the reference, the reference moved to the Fox's fractions, and
+  // the automatic joints.
+  auto bone_error = [](const std::string& joints) {
+    auto job = jf_job("anim/Fox/glTF-Binary/Fox.glb", "anim/wolf0.ply", joints);
+    EXPECT_TRUE(job->status.ok()) << job->status.message;
+    if (!job->status.ok()) return std::nan("");
+    const mm::HarmonicRetargeter& Hr = job->session.harmonic();
+    std::vector<Eigen::MatrixXd> frames;
+    for (int k = 0; k < job->session.num_frames(); ++k) frames.push_back(Hr.retarget(job->session.source_frame(k)).joints);
+    return mm::bone_length_error(frames, Hr.bones(), Hr.rest_bone_lengths()).mean;
+  };
+  const double e_hand = bone_error(jf_read("joints/wolf0_joints.json"));
+  const double e_moved = bone_error(mm::app::joints_json_text(moved));
+  const double e_auto = bone_error("auto");
+  std::cout << "[ Fox -> wolf0 bone-length error ] hand-placed " << e_hand << ", hand-placed at the Fox's fractions " << e_moved
+            << ", automatic " << e_auto << "\n";
+  EXPECT_GT(e_moved - e_hand, 0.5 * (e_auto - e_hand)) << "the convention explains less of the gap than measured";
 }
 
 TEST(JointsJob, JsonReadsBackAndDrivesRetarget) {
