@@ -334,8 +334,10 @@ CurveSkeleton curve_skeleton(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   for (int k = 0; k < 3; ++k) dims[k] = int(std::ceil((hi[k] - lo[k]) / h)) + 1 + 2 * pad;
   g.nx = dims[0], g.ny = dims[1], g.nz = dims[2];
   VoxelSolid& vs = out.volume;
+  // Centred on the bounding box, so a mesh turned by 180° about an axis (facing −z instead of +z)
+  // meets the same cells mirrored.
   for (int k = 0; k < 3; ++k) {
-    vs.grid.lo[k] = lo[k] - pad * h;
+    vs.grid.lo[k] = 0.5 * (lo[k] + hi[k]) - 0.5 * dims[k] * h;
     vs.grid.dims[k] = dims[k];
   }
   vs.grid.cell = h;
