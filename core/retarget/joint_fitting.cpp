@@ -1190,6 +1190,11 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     }
   }
 
+  // The source joint of each placed joint (steps 5c and the crossing check below).
+  std::vector<int> src_of(out.size(), -1);
+  for (int j : used)
+    if (out_index[j] >= 0) src_of[out_index[j]] = j;
+
   // 5c. Skeleton prior: every bone of the fit pulled toward the source's bone carried by the
   // global similarity (b = R (H_t/H_s) (s_c − s_p)), least squares against the fitted positions:
   //   min Σ_j |p_j − p̂_j|² + w Σ_(c,p) |(p_c − p_p) − b_cp|²
@@ -1201,9 +1206,6 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
   // would pull joints off the target's anatomy. A self fit is unchanged (r = 0, p̂ = source).
   if (opt.skeleton_prior > 0 && out.size() > 1) {
     const int n = out.size();
-    std::vector<int> src_of(n, -1);
-    for (int j : used)
-      if (out_index[j] >= 0) src_of[out_index[j]] = j;
     std::vector<std::pair<int, Eigen::Vector3d>> bones;  // (child k, source bone in target frame)
     BoneAgreement agreement;
     for (int k = 0; k < n; ++k) {
@@ -1263,9 +1265,6 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     const Eigen::Vector3d side = us.cross(jf_axis(opt.source_front));
     const Eigen::Vector3d cs = 0.5 * (Vs.colwise().minCoeff() + Vs.colwise().maxCoeff()).transpose();
     const Eigen::Vector3d ct = 0.5 * (Vt.colwise().minCoeff() + Vt.colwise().maxCoeff()).transpose();
-    std::vector<int> src_of(out.size(), -1);
-    for (int j : used)
-      if (out_index[j] >= 0) src_of[out_index[j]] = j;
     auto side_s = [&](int k) {
       const double x = side.dot(source_joints.P.row(src_of[k]).transpose() - cs) / fs.H;
       return x > 0.05 ? 1 : x < -0.05 ? -1 : 0;
