@@ -42,6 +42,8 @@ const OptionSchema<JointsJobOptions>& joints_options() {
              "the prior is used in full while the fitted bones differ from the source's by at most this (relative), and not at all beyond 1.6 x this");
     s.number("offset_cap", [](O& o) -> double& { return o.fit.offset_cap; }, 0, 100,
              "outside the source's rig family, a joint's offset from its skeleton point is at most this x the skeleton's radius there (0 = off)");
+    s.number("ball_joint_reach", [](O& o) -> double& { return o.fit.ball_joint_reach; }, 0, 100,
+             "a target built of parts bends at its small round parts: a fitted joint within this x such a ball's radius of its centre moves there (0 = off)");
     s.integer("marker_reach", [](O& o) -> int& { return o.fit.marker_reach; }, 0, 100,
               "markers also move joints up to this many bones away");
     s.number("marker_anchor", [](O& o) -> double& { return o.fit.marker_anchor; }, 0, 1,

@@ -25,6 +25,7 @@
 #include "retarget/curve_skeleton.h"
 #include "retarget/joint_fitting.h"
 #include "spatial/triangle_bvh.h"
+#include "test_meshes.h"
 #include "test_support.h"
 
 namespace {
@@ -436,8 +437,154 @@ TEST(JointFitting, CesiumManSkeletonInRobot) {
   jf_report(this, "CesiumMan joints in RobotExpressive (10 key joints)", r);
   EXPECT_EQ(r.outside, 0);
   EXPECT_EQ(r.error.count, 10);
-  EXPECT_LE(r.error.mean, 0.058);  // issue 14 asks 0.03 (above); 6.0 → 5.4 % in the thirty-third session (the robot's
-                                  // hands no longer count as feet, so its touching legs are split)
+  EXPECT_LE(r.error.mean, 0.035);  // issue 14 asks 0.03 (above); 6.0 → 5.4 % in the thirty-third session (the robot's
+                                  // hands no longer count as feet, so its touching legs are split); 5.43 → 3.23 %
+                                  // in the forty-sixth (its ball joints take the joints that reach them, step 5d)
+}
+
+// Step 5d (forty-sixth session): RobotExpressive is built of 63 parts, and it bends at small round
+// ones — its hip, elbow and neck joints lie 0.016, 0.002 and 0.007 of its height from the centres of
+// its balls. CesiumMan's joints carried over by proportions landed 0.04–0.07 of the height from them
+// (5.43 % over the 10 key joints); moved to the balls they reached: 3.23 %.
+TEST(JointFitting, BallPartsOfTheRobotTakeTheJointsThatReachThem) {
+  const JfCharacter robot = jf_character("anim/RobotExpressive/RobotExpressive.glb");
+  const double H = jf_extent(robot.c.V_rest, 1);
+  const std::vector<mm::BallPart> balls = mm::ball_parts(robot.c.V_rest, robot.c.F, H);
+  // Hips, elbows, neck, ankles: 7 balls (its eyes are round too but 0.18 of its height across;
+  // its shoulder caps are open surfaces).
+  ASSERT_EQ(balls.size(), 7u);
+  for (const mm::BallPart& b : balls) {
+    EXPECT_GT(b.roundness, 0.95);
+    EXPECT_GT(b.radius, 0.02 * H);
+    EXPECT_LT(b.radius, 0.05 * H);
+  }
+  for (const char* name : {"UpperLeg.L", "UpperLeg.R", "LowerArm.L", "LowerArm.R", "Neck"}) {
+    const Eigen::Vector3d j = robot.joints.P.row(robot.joints.find(name)).transpose();
+    double nearest = 1e300;
+    for (const mm::BallPart& b : balls) nearest = std::min(nearest, (b.centre - j).norm());
+    EXPECT_LT(nearest, 0.02 * H) << name;
+  }
+  // Single-part and open-part characters have none.
+  for (const char* c : {"anim/CesiumMan/CesiumMan.glb", "anim/KayKit/Knight.glb", "anim/KayKit/Barbarian.glb", "anim/Fox/glTF-Binary/Fox.glb"}) {
+    const JfCharacter other = jf_character(c);
+    EXPECT_TRUE(mm::ball_parts(other.c.V_rest, other.c.F, jf_extent(other.c.V_rest, 1)).empty()) << c;
+  }
+
+  // CesiumMan → robot with and without the step.
+  const JfCharacter cesium = jf_character("anim/CesiumMan/CesiumMan.glb");
+  mm::JointFitOptions o;
+  o.target_up = 1;
+  o.target_front = 2;
+  const mm::JointFitResult with = mm::fit_joints(cesium.c.V_rest, cesium.c.F, cesium.joints, robot.c.V_rest, robot.c.F, {}, o);
+  o.ball_joint_reach = 0;
+  const mm::JointFitResult without = mm::fit_joints(cesium.c.V_rest, cesium.c.F, cesium.joints, robot.c.V_rest, robot.c.F, {}, o);
+  ASSERT_TRUE(with.status.ok()) << with.status.message;
+  ASSERT_TRUE(without.status.ok()) << without.status.message;
+  EXPECT_TRUE(without.ball_joints.empty());
+  const std::map<std::string, std::string> map = jf_inverse(kRobotToCesium);
+  const JfError e_with = jf_joint_error(with.joints, robot.joints, H, map), e_without = jf_joint_error(without.joints, robot.joints, H, map);
+  jf_print("CesiumMan joints in RobotExpressive without ball joints", e_without, without);
+  EXPECT_LT(e_with.mean, e_without.mean - 0.015);
+  for (const char* cesium_name : {"Skeleton_arm_joint_L__3_", "Skeleton_arm_joint_R__2_", "leg_joint_L_1", "leg_joint_R_1"}) {
+    EXPECT_NE(std::find(with.ball_joints.begin(), with.ball_joints.end(), cesium_name), with.ball_joints.end()) << cesium_name;
+    const Eigen::Vector3d fit = with.joints.P.row(with.joints.find(cesium_name)).transpose();
+    const Eigen::Vector3d truth = robot.joints.P.row(robot.joints.find(map.at(cesium_name))).transpose();
+    EXPECT_LT((fit - truth).norm(), 0.02 * H) << cesium_name;
+  }
+  ASSERT_FALSE(with.warnings.empty());
+  EXPECT_NE(with.warnings.back().find("ball parts"), std::string::npos) << with.warnings.back();
+
+  // KayKit Knight's arm fits short in the robot: its left elbow ball lies at 0.44 of the fitted
+  // upper arm, a ball neither end of that bone takes (snapping the shoulder joint to it put it
+  // 0.14 of the height from the robot's).
+  const JfCharacter knight = jf_character("anim/KayKit/Knight.glb");
+  o.ball_joint_reach = 3;
+  const mm::JointFitResult k = mm::fit_joints(knight.c.V_rest, knight.c.F, knight.joints, robot.c.V_rest, robot.c.F, {}, o);
+  ASSERT_TRUE(k.status.ok()) << k.status.message;
+  EXPECT_EQ(std::find(k.ball_joints.begin(), k.ball_joints.end(), "upperarm.l"), k.ball_joints.end());
+  EXPECT_NE(std::find(k.ball_joints.begin(), k.ball_joints.end(), "upperleg.l"), k.ball_joints.end());
+}
+
+// What counts as a ball part, and which joint a ball goes to.
+TEST(JointFitting, BallPartsAreSmallClosedAndRound) {
+  Eigen::MatrixXd S;
+  Eigen::MatrixXi SF;
+  mm::test::icosphere(2, &S, &SF);  // unit sphere, 320 triangles
+  // A body (a large sphere, 10 across: the character's height), a ball of radius 0.3 cut along a
+  // seam (every vertex on one side duplicated, as glTF stores UV seams), a cube of the same size, and
+  // an open hemisphere.
+  std::vector<Eigen::MatrixXd> Vs;
+  std::vector<Eigen::MatrixXi> Fs;
+  Vs.push_back(5 * S), Fs.push_back(SF);
+  {
+    Eigen::MatrixXd V(2 * S.rows(), 3);
+    V << 0.3 * S, 0.3 * S;
+    V.rowwise() += Eigen::RowVector3d(2, 0, 0);
+    Eigen::MatrixXi F = SF;
+    for (int f = 0; f < F.rows(); ++f)
+      if (S(F(f, 0), 0) + S(F(f, 1), 0) + S(F(f, 2), 0) > 0) F.row(f).array() += int(S.rows());
+    Vs.push_back(V), Fs.push_back(F);
+  }
+  {
+    Eigen::MatrixXd V(8, 3);
+    for (int i = 0; i < 8; ++i) V.row(i) << ((i & 1) ? 0.25 : -0.25), ((i & 2) ? 0.25 : -0.25), ((i & 4) ? 0.25 : -0.25);
+    V.rowwise() += Eigen::RowVector3d(0, 2, 0);
+    Eigen::MatrixXi F(12, 3);
+    F << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5;
+    Vs.push_back(V), Fs.push_back(F);
+  }
+  {
+    std::vector<int> keep;
+    for (int f = 0; f < SF.rows(); ++f)
+      if (S(SF(f, 0), 2) + S(SF(f, 1), 2) + S(SF(f, 2), 2) > 0) keep.push_back(f);
+    Eigen::MatrixXi F(keep.size(), 3);
+    for (size_t i = 0; i < keep.size(); ++i) F.row(i) = SF.row(keep[i]);
+    Vs.push_back(0.3 * S), Fs.push_back(F);
+    Vs.back().rowwise() += Eigen::RowVector3d(0, -2, 0);
+  }
+  Eigen::MatrixXd V(0, 3);
+  Eigen::MatrixXi F(0, 3);
+  for (size_t i = 0; i < Vs.size(); ++i) {
+    const int base = V.rows();
+    V.conservativeResize(V.rows() + Vs[i].rows(), 3);
+    V.bottomRows(Vs[i].rows()) = Vs[i];
+    F.conservativeResize(F.rows() + Fs[i].rows(), 3);
+    F.bottomRows(Fs[i].rows()) = Fs[i].array() + base;
+  }
+  std::vector<mm::BallPart> balls = mm::ball_parts(V, F, 10);
+  ASSERT_EQ(balls.size(), 1u) << "the seamed ball only (the body is too large, the cube not round, the cap open)";
+  EXPECT_LT((balls[0].centre - Eigen::Vector3d(2, 0, 0)).norm(), 1e-9);
+  EXPECT_NEAR(balls[0].radius, 0.3, 0.01);
+  EXPECT_GT(balls[0].roundness, 0.97);
+  mm::BallPartOptions loose;
+  loose.min_roundness = 0.8;
+  EXPECT_EQ(mm::ball_parts(V, F, 10, loose).size(), 2u) << "the cube's sphericity is 0.81";
+  EXPECT_TRUE(mm::ball_parts(5 * S, SF, 10).empty()) << "a single part";
+
+  // Pairing: a chain 0 → 1 → 2 along x, joints 1 apart, the ball (radius 0.3) moved along it.
+  Eigen::MatrixXd P(3, 3);
+  P << 0, 0, 0, 1, 0, 0, 2, 0, 0;
+  const std::vector<int> parent = {-1, 0, 1};
+  auto take = [&](double x, double y = 0) {
+    balls[0].centre = Eigen::Vector3d(x, y, 0);
+    return mm::pair_balls_with_joints(balls, P, parent, 3)[0];
+  };
+  EXPECT_EQ(take(1.2), 1);
+  EXPECT_EQ(take(0.7), 1);
+  EXPECT_EQ(take(1.45), -1) << "0.45 of the bone from joint 1: left to neither";
+  EXPECT_EQ(take(1.5), -1);
+  EXPECT_EQ(take(1.65), 2);
+  EXPECT_EQ(take(1, 0.85), 1);
+  EXPECT_EQ(take(1, 0.95), -1) << "beyond 3 radii";
+  balls[0].centre = Eigen::Vector3d(1.45, 0, 0);
+  EXPECT_EQ(mm::pair_balls_with_joints(balls, P, {}, 3)[0], 1) << "no bones: the nearest joint within reach";
+  // Two balls near one joint: the nearer takes it, the other none.
+  balls.push_back(balls[0]);
+  balls[0].centre = Eigen::Vector3d(1.1, 0, 0);
+  balls[1].centre = Eigen::Vector3d(0.8, 0.1, 0);
+  const std::vector<int> two = mm::pair_balls_with_joints(balls, P, parent, 3);
+  EXPECT_EQ(two[0], 1);
+  EXPECT_EQ(two[1], -1);
 }
 
 // With a second thread the source's skeleton and tree are built on a pool task beside the

@@ -607,6 +607,7 @@ struct JfInputs {
   const std::vector<JointMarker>& markers;
   const JointFitOptions& opt;
   const Progress& progress;
+  const std::vector<BallPart> &balls_s, &balls_t;  // step 5d
 };
 
 // How far fitted bones d are from the source's bones b in the target's frame, Σ|d − b| / Σ|b|
@@ -1256,6 +1257,43 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     }
   }
 
+  // 5d. Ball joints. A target built of separate parts bends where its small round parts sit (the
+  // robot's hips, elbows, neck and ankles are the centres of such balls; its true hip and elbow
+  // joints lie 0.016 and 0.002 of its height from them). A fitted joint and a ball that are each
+  // other's nearest, within ball_joint_reach radii, make a pair: the joint moves to the ball's
+  // centre, plus its source joint's offset from the source's own ball (carried into the target's
+  // axes and scale) where the source's joint has one — a self fit of the robot stays exact, and a
+  // rig that keeps a joint off its ball keeps it off the target's. Fits onto single-part meshes
+  // are unchanged (no balls).
+  if (opt.ball_joint_reach > 0 && !in.balls_t.empty()) {
+    Eigen::MatrixXd Pt = out.P;
+    for (const std::string& nm : outside) Pt.row(out.find(nm)).setConstant(std::numeric_limits<double>::quiet_NaN());
+    const std::vector<int> t_pair = pair_balls_with_joints(in.balls_t, Pt, out.parent, opt.ball_joint_reach);
+    std::vector<int> s_ball(source_joints.size(), -1);
+    if (!in.balls_s.empty()) {
+      // The placed joints in the source, with the placed joints' hierarchy.
+      Eigen::MatrixXd Ps(out.size(), 3);
+      for (int k = 0; k < out.size(); ++k) Ps.row(k) = source_joints.P.row(src_of[k]);
+      const std::vector<int> s_pair = pair_balls_with_joints(in.balls_s, Ps, out.parent, opt.ball_joint_reach);
+      for (size_t b = 0; b < s_pair.size(); ++b)
+        if (s_pair[b] >= 0) s_ball[src_of[s_pair[b]]] = int(b);
+    }
+    for (size_t b = 0; b < t_pair.size(); ++b) {
+      const int k = t_pair[b];
+      if (k < 0 || src_of[k] < 0) continue;
+      Eigen::Vector3d p = in.balls_t[b].centre;
+      if (const int sb = s_ball[src_of[k]]; sb >= 0)
+        p += R.transpose() * (source_joints.P.row(src_of[k]).transpose() - in.balls_s[sb].centre) * (ft.H / fs.H);
+      if (!inside_t(p)) continue;
+      out.P.row(k) = p.transpose();
+      r.ball_joints.push_back(out.names[k]);
+    }
+    if (!r.ball_joints.empty())
+      r.warnings.push_back(std::to_string(r.ball_joints.size()) + " joint" + (r.ball_joints.size() > 1 ? "s" : "") +
+                           " moved to the centre of the target's ball parts (" + jf_join(r.ball_joints, 8) +
+                           "; option ball_joint_reach 0 turns this off)");
+  }
+
   // Limbs that cross the body's middle: a bone whose two joints lie well to one side in the source
   // (beyond 0.05 of its height from its middle plane, the same side) but on opposite sides in the
   // target (beyond 0.01). A fit whose skeleton is broken (human_woman at 48 cells, centred grid:
@@ -1401,7 +1439,13 @@ JointFitResult fit_joints(const Eigen::MatrixXd& Vs, const Eigen::MatrixXi& Fs, 
     else r.skipped.push_back(source_joints.names[j]);
   }
   if (used.size() < 2) return fail(StatusCode::InvalidArgument, "fewer than 2 source joints lie inside the source surface");
-  const JfInputs in{Vs, Vt, Fs, Ft, source_joints, used, bvh_s, bvh_t, tol_t, markers, opt, progress};
+  // Step 5d's ball parts of both characters (sizes against the longest side of each).
+  const auto balls_of = [&](const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+    return opt.ball_joint_reach > 0 ? ball_parts(V, F, (V.colwise().maxCoeff() - V.colwise().minCoeff()).maxCoeff(), opt.balls)
+                                    : std::vector<BallPart>{};
+  };
+  const std::vector<BallPart> balls_s = balls_of(Vs, Fs), balls_t = balls_of(Vt, Ft);
+  const JfInputs in{Vs, Vt, Fs, Ft, source_joints, used, bvh_s, bvh_t, tol_t, markers, opt, progress, balls_s, balls_t};
   // The source's curve skeleton first (Voxel, Auto); Auto falls back to the source's own bones
   // when a source limb finds no partner (blocky, many-part sources: KayKit's 24 limb ends).
   // Markers on a lost limb lift its refusal (their joints place it) only where no tree fits

@@ -30,6 +30,10 @@
 //     (posed onto the fitted joints bone by bone) to its closest target points — a joint centred
 //     in a thigh stays centred in a thicker one; a few rounds, each move at most twice the
 //     joint's depth (measured: Knight's joints in Barbarian 0.78 → 0.60 % of the height);
+//  5d. a target built of separate parts bends at its ball parts (small closed round parts: a robot's
+//     or a mannequin's ball joints); a fitted joint that has reached one (each the other's nearest,
+//     within ball_joint_reach radii) moves to its centre — plus the source joint's offset from its
+//     own ball where the source has ball parts too, so a self fit stays exact;
 //  6. a joint outside the target is pulled toward its skeleton point until inside; markers pin
 //     named joints and drag their chain neighbours (weights fall off over marker_reach joints).
 // Source joints outside the source surface (roots on the floor, IK targets) are not placed.
@@ -47,6 +51,7 @@
 #include "character/joint_set.h"
 #include "common/progress.h"
 #include "common/status.h"
+#include "retarget/ball_parts.h"
 #include "retarget/curve_skeleton.h"
 
 namespace mm {
@@ -94,6 +99,10 @@ struct JointFitOptions {
                                    // fading to 0 at 1.6 × this (a target of the source's rig family)
   double offset_cap = 2.5;         // step 5: unless the target is of the source's rig family (the skeleton prior's gate),
                                   // a joint's offset from its skeleton point is at most this × the source radius there (0 = off)
+  double ball_joint_reach = 3;    // step 5d: a fitted joint within this × a ball part's radius of its centre (each the
+                                  // other's nearest) moves there, plus its source joint's offset from its own ball if the
+                                  // source has one (0 = off)
+  BallPartOptions balls;          // ... what counts as a ball part (retarget/ball_parts.h)
   int marker_reach = 3;           // markers move unpinned joints up to this many bones away (0 = only pin)
   double marker_anchor = 0.1;     // step 5: a marker within this × height of a target path between matched ends
                                   // anchors the proportions along it (0 = off)
@@ -118,6 +127,7 @@ struct JointFitResult {
   int source_ground = 0, target_ground = 0;    // limb ends on the ground (step 4)
   double skeleton_agreement = 0;  // step 5c: Σ|d − b| / Σ|b| of the fitted bones d against the source's b
   double skeleton_prior_used = 0; // the prior's weight after that gate (0: not applied)
+  std::vector<std::string> ball_joints;  // step 5d: joints moved to the centre of a ball part of the target
 };
 
 // Vs/Fs: source rest surface; source_joints: its joints (names, positions, parents).

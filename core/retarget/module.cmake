@@ -9,6 +9,7 @@ list(APPEND MM_CORE_SOURCES
   core/retarget/bone_blend.cpp
   core/retarget/harmonic_retarget_graph.cpp
   core/retarget/lbs_baseline.cpp
+  core/retarget/ball_parts.cpp
   core/retarget/curve_skeleton.cpp
   core/retarget/joint_fitting.cpp)
 list(APPEND MM_TEST_SOURCES tests/retarget_test.cpp tests/joint_fitting_test.cpp tests/context_graph_test.cpp)
