@@ -11,8 +11,11 @@
 // The raw layout (V_raw/F_raw) concatenates primitives; the geometry mesh every algorithm
 // uses is the welded one (glTF splits vertices at UV/normal seams; see mesh/weld.h).
 //
-// Skinned primitives get their node's world transform too (positions are the bind pose as
-// placed by the node); PrimitiveRef::skinned marks them.
+// Skinned primitives are in their rest pose: the skin applied at the nodes' own transforms, as
+// glTF viewers draw them (glTF 2.0: a skinned mesh is placed by its joints, not by its node).
+// Where that equals the bind pose as placed by the node (every character in data/ but
+// RobotExpressive's hands, whose bind pose has the arms spread), V_raw is the node's world
+// transform of the positions, exactly; PrimitiveRef::skinned marks them, rest_skin the others.
 //
 // Security: external URIs of a .gltf are resolved only inside the file's own folder; absolute
 // paths, "..", and URI schemes other than data: are refused with IoError before the resolver
@@ -62,10 +65,23 @@ struct PrimitiveRef {
   int num_vertices = 0;
   int first_face = 0;      // range in F_raw
   int num_faces = 0;
-  bool skinned = false;    // node has a skin (positions are the bind pose)
+  bool skinned = false;    // node has a skin
   Eigen::Matrix4d world = Eigen::Matrix4d::Identity();  // node world transform
+  // A skinned primitive whose rest pose (its skin at the nodes' own transforms, as viewers show
+  // it) differs from its bind pose as placed by the node: per vertex the 3×4 affine map from mesh
+  // space to world space, row-major (#num_vertices by 12); V_raw holds the rest pose and saving maps
+  // positions back through it. Empty otherwise (V_raw = world × mesh-space positions).
+  Eigen::MatrixXd rest_skin;
   std::string name;        // "<node name>/<mesh name>#<primitive>"
 };
+
+// Vertex v's map of a PrimitiveRef::rest_skin (mesh space → world space).
+inline Eigen::Matrix<double, 3, 4> rest_skin_map(const Eigen::MatrixXd& rest_skin, Eigen::Index v) {
+  Eigen::Matrix<double, 3, 4> a;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) a(r, c) = rest_skin(v, 4 * r + c);
+  return a;
+}
 
 class Document;  // format-specific contents (tinygltf::Model, OBJ lines, PLY properties)
 

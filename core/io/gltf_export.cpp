@@ -35,8 +35,11 @@ ExportMesh gltf_export_mesh(const Asset& asset, const Eigen::MatrixXd& V_raw_out
       if (normals) {
         // Normals transform with the inverse transpose of the node's linear part.
         const Eigen::Matrix3d Nm = ref.world.topLeftCorner<3, 3>().inverse().transpose();
-        for (int v = 0; v < ref.num_vertices; ++v)
-          dst->row(ref.first_vertex + v) = (Nm * A.row(v).leftCols<3>().transpose()).normalized().transpose();
+        const bool rest = ref.rest_skin.rows() == ref.num_vertices;  // per-vertex maps (asset.h)
+        for (int v = 0; v < ref.num_vertices; ++v) {
+          const Eigen::Matrix3d N = rest ? Eigen::Matrix3d(rest_skin_map(ref.rest_skin, v).leftCols<3>().inverse().transpose()) : Nm;
+          dst->row(ref.first_vertex + v) = (N * A.row(v).leftCols<3>().transpose()).normalized().transpose();
+        }
       } else {
         dst->middleRows(ref.first_vertex, ref.num_vertices) = A.leftCols(cols);
       }

@@ -133,10 +133,15 @@ Status save_gltf_document(const Asset& asset, const Eigen::MatrixXd& V_raw_out, 
     const Eigen::Matrix4d inv = ref.world.inverse();
     for (int v = 0; v < ref.num_vertices; ++v) {
       if (!moved[ref.first_vertex + v]) continue;
-      const Eigen::Vector4d p = inv * Eigen::Vector4d(V_raw_out(ref.first_vertex + v, 0),
-                                                      V_raw_out(ref.first_vertex + v, 1),
-                                                      V_raw_out(ref.first_vertex + v, 2), 1.0);
-      L.row(v) << p.x(), p.y(), p.z();
+      const Eigen::Vector3d x = V_raw_out.row(ref.first_vertex + v).transpose();
+      if (ref.rest_skin.rows() == ref.num_vertices) {
+        // Through the vertex's rest-pose skin map (asset.h): skinned at rest it lands on x.
+        const Eigen::Matrix<double, 3, 4> a = rest_skin_map(ref.rest_skin, v);
+        L.row(v) = a.leftCols<3>().partialPivLu().solve(x - a.col(3)).transpose();
+      } else {
+        const Eigen::Vector4d p = inv * x.homogeneous();
+        L.row(v) << p.x(), p.y(), p.z();
+      }
       inst.changed = true;
     }
     if (!L.allFinite())
