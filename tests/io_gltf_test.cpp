@@ -13,6 +13,7 @@
 #include "io/asset.h"
 #include "io/gltf_animation.h"
 #include "io/gltf_document.h"
+#include "io/info_report.h"
 #include "test_support.h"
 
 namespace {
@@ -259,6 +260,10 @@ TEST(IoGltf, RobotExpressiveRestPoseMatchesAnIndependentReading) {
   int with_rest_skin = 0;
   for (const mm::io::PrimitiveRef& p : r.asset.primitives) with_rest_skin += p.rest_skin.rows() == p.num_vertices;
   EXPECT_EQ(with_rest_skin, 4);
+  // `meshmorph info` and the page's info panel say so.
+  const mm::io::InfoReport info = mm::io::info_report(r.asset);
+  EXPECT_NE(info.text.find("Hand.R/Hand.R#0: 256 vertices, 124 triangles, skinned (shown in its rest pose"), std::string::npos) << info.text;
+  EXPECT_NE(info.json.find("\"rest_pose_from_skin\":true"), std::string::npos);
   // The same rest pose as the character the retargeting reads (core/character), box for box.
   const mm::io::CharacterResult c = mm::io::animated_character(r.asset, {mm::io::SurfaceSelection::All});
   ASSERT_TRUE(c.status.ok()) << c.status.message;

@@ -48,7 +48,8 @@ InfoReport info_report(const Asset& asset) {
   j["raw_faces"] = asset.F_raw.rows();
   nlohmann::json prims = nlohmann::json::array();
   for (const auto& p : asset.primitives)
-    prims.push_back({{"name", p.name}, {"vertices", p.num_vertices}, {"faces", p.num_faces}, {"skinned", p.skinned}});
+    prims.push_back({{"name", p.name}, {"vertices", p.num_vertices}, {"faces", p.num_faces}, {"skinned", p.skinned},
+                     {"rest_pose_from_skin", p.rest_skin.rows() > 0}});
   j["primitives"] = prims;
   j["welded"] = mesh_report_json(out.welded);
   j["raw_defects"] = mesh_report_json(out.raw)["defects"];
@@ -61,7 +62,8 @@ InfoReport info_report(const Asset& asset) {
      << asset.primitives.size() << " primitive(s)\n";
   for (const auto& p : asset.primitives)
     os << "  " << (p.name.empty() ? "(unnamed)" : p.name) << ": " << p.num_vertices << " vertices, " << p.num_faces
-       << " triangles" << (p.skinned ? ", skinned" : "") << "\n";
+       << " triangles" << (p.skinned ? ", skinned" : "")
+       << (p.rest_skin.rows() > 0 ? " (shown in its rest pose: its bind pose differs)" : "") << "\n";
   os << "welded mesh (what the methods use):\n";
   std::istringstream body(out.welded.to_text());
   for (std::string line; std::getline(body, line);) os << "  " << line << "\n";
