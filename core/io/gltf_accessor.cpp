@@ -224,4 +224,35 @@ Status read_gltf_triangles(const tinygltf::Model& model, const tinygltf::Primiti
   return Status::success();
 }
 
+bool read_gltf_inverse_binds(const tinygltf::Model& model, const tinygltf::Skin& skin, Matrix4dList* out) {
+  out->assign(skin.joints.size(), Eigen::Matrix4d::Identity());
+  if (skin.inverseBindMatrices < 0) return true;
+  Eigen::MatrixXd ib;
+  if (!read_gltf_accessor(model, skin.inverseBindMatrices, &ib).ok() || ib.cols() != 16 ||
+      ib.rows() < static_cast<Eigen::Index>(skin.joints.size()))
+    return false;
+  for (size_t j = 0; j < skin.joints.size(); ++j)
+    for (int k = 0; k < 16; ++k) (*out)[j](k % 4, k / 4) = ib(static_cast<Eigen::Index>(j), k);  // column-major
+  return true;
+}
+
+bool read_gltf_skin_influences(const tinygltf::Model& model, const tinygltf::Primitive& prim, Eigen::Index nv,
+                               Eigen::MatrixXd* joints, Eigen::MatrixXd* weights) {
+  joints->resize(nv, 0);
+  weights->resize(nv, 0);
+  for (int set = 0;; ++set) {
+    const auto ja = prim.attributes.find("JOINTS_" + std::to_string(set));
+    const auto wa = prim.attributes.find("WEIGHTS_" + std::to_string(set));
+    if (ja == prim.attributes.end() || wa == prim.attributes.end()) return true;
+    Eigen::MatrixXd j, w;
+    if (!read_gltf_accessor(model, ja->second, &j).ok() || !read_gltf_accessor(model, wa->second, &w).ok() ||
+        j.rows() != nv || w.rows() != nv || j.cols() != 4 || w.cols() != 4)
+      return false;
+    joints->conservativeResize(nv, 4 * (set + 1));
+    weights->conservativeResize(nv, 4 * (set + 1));
+    joints->rightCols<4>() = j;
+    weights->rightCols<4>() = w;
+  }
+}
+
 }  // namespace mm::io

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include "common/status.h"
+#include "character/skinning.h"
 #include "io/gltf_document.h"
 
 namespace mm::io {
@@ -21,6 +22,16 @@ int gltf_component_size(int component_type);
 // byteStride, normalized integers (mapped to [0,1] / [-1,1]) and sparse substitution applied.
 // An accessor without a bufferView reads as zeros (plus its sparse values).
 Status read_gltf_accessor(const tinygltf::Model& model, int index, Eigen::MatrixXd* out);
+
+// A skin's inverse bind matrices, one per joint (identity for a skin without them). False when the
+// accessor is unreadable, not MAT4, or shorter than the joint list.
+bool read_gltf_inverse_binds(const tinygltf::Model& model, const tinygltf::Skin& skin, Matrix4dList* out);
+
+// A primitive's JOINTS_n / WEIGHTS_n, n = 0, 1, ... while both are present, side by side: #nv by
+// 4 × sets (0 columns without JOINTS_0/WEIGHTS_0). Joint slots are read as doubles, unchecked.
+// False when a set is unreadable or not #nv by 4.
+bool read_gltf_skin_influences(const tinygltf::Model& model, const tinygltf::Primitive& prim, Eigen::Index nv,
+                               Eigen::MatrixXd* joints, Eigen::MatrixXd* weights);
 
 // TRIANGLES (4, or -1 = default), TRIANGLE_STRIP (5) and TRIANGLE_FAN (6) make triangles.
 bool gltf_is_triangle_mode(int mode);

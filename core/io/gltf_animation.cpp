@@ -71,16 +71,9 @@ CharacterResult animated_character(const Asset& asset, const CharacterOptions& o
     CharacterSkin cs;
     cs.name = sk.name;
     cs.joints = sk.joints;
-    cs.inverse_bind.assign(sk.joints.size(), Eigen::Matrix4d::Identity());
-    if (sk.inverseBindMatrices >= 0) {
-      Eigen::MatrixXd ib;
-      Status st = read_gltf_accessor(m, sk.inverseBindMatrices, &ib);
-      if (!st.ok() || ib.cols() != 16 || ib.rows() < static_cast<Eigen::Index>(sk.joints.size())) {
-        r.status = Status::error(StatusCode::ParseError, "skin " + std::to_string(s) + ": bad inverseBindMatrices accessor");
-        return r;
-      }
-      for (size_t j = 0; j < sk.joints.size(); ++j)
-        for (int k = 0; k < 16; ++k) cs.inverse_bind[j](k % 4, k / 4) = ib(j, k);
+    if (!read_gltf_inverse_binds(m, sk, &cs.inverse_bind)) {
+      r.status = Status::error(StatusCode::ParseError, "skin " + std::to_string(s) + ": bad inverseBindMatrices accessor");
+      return r;
     }
     for (int j : cs.joints)
       if (j < 0 || j >= nn) {
@@ -168,30 +161,21 @@ CharacterResult animated_character(const Asset& asset, const CharacterOptions& o
       if (node.skin >= 0 && node.skin < static_cast<int>(c.skins.size()) && prim.attributes.count("JOINTS_0") &&
           prim.attributes.count("WEIGHTS_0")) {
         p.skin = node.skin;
-        std::vector<Eigen::MatrixXd> J, W;
-        for (int set = 0;; ++set) {
-          auto ja = prim.attributes.find("JOINTS_" + std::to_string(set));
-          auto wa = prim.attributes.find("WEIGHTS_" + std::to_string(set));
-          if (ja == prim.attributes.end() || wa == prim.attributes.end()) break;
-          Eigen::MatrixXd j, w;
-          if (!read_gltf_accessor(m, ja->second, &j).ok() || !read_gltf_accessor(m, wa->second, &w).ok() ||
-              j.rows() != p.num_vertices || w.rows() != p.num_vertices || j.cols() != 4 || w.cols() != 4) {
-            r.status = Status::error(StatusCode::ParseError, "mesh " + std::to_string(node.mesh) + ": bad JOINTS/WEIGHTS");
-            return r;
-          }
-          J.push_back(j);
-          W.push_back(w);
+        Eigen::MatrixXd J, W;
+        if (!read_gltf_skin_influences(m, prim, p.num_vertices, &J, &W)) {
+          r.status = Status::error(StatusCode::ParseError, "mesh " + std::to_string(node.mesh) + ": bad JOINTS/WEIGHTS");
+          return r;
         }
-        const int K = 4 * static_cast<int>(J.size());
+        const int K = static_cast<int>(J.cols());
         p.joints.resize(p.num_vertices, K);
         p.weights.resize(p.num_vertices, K);
         const int nj = static_cast<int>(c.skins[p.skin].joints.size());
         for (int v = 0; v < p.num_vertices; ++v) {
           double sum = 0;
-          for (size_t s = 0; s < J.size(); ++s)
+          for (int s = 0; s < K / 4; ++s)
             for (int k = 0; k < 4; ++k) {
-              const int slot = static_cast<int>(J[s](v, k));
-              double w = W[s](v, k);
+              const int slot = static_cast<int>(J(v, 4 * s + k));
+              double w = W(v, 4 * s + k);
               if (slot < 0 || slot >= nj) {
                 if (w != 0) {
                   r.status = Status::error(StatusCode::ParseError, "mesh " + std::to_string(node.mesh) +

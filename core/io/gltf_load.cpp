@@ -22,63 +22,49 @@ namespace mm::io {
 // when the file is at fault) when the primitive has no JOINTS_0/WEIGHTS_0, a joint lies outside
 // the scene, or an accessor is unreadable.
 static bool gltf_rest_skin(const tinygltf::Model& m, const tinygltf::Primitive& prim, int skin_index,
-                    const std::vector<Eigen::Matrix4d>& world, const std::vector<char>& placed, Eigen::Index nv,
-                    Eigen::MatrixXd* A, std::string* why) {
+                           const std::vector<Eigen::Matrix4d>& world, const std::vector<char>& placed, Eigen::Index nv,
+                           Eigen::MatrixXd* A, std::string* why) {
   if (skin_index < 0 || skin_index >= static_cast<int>(m.skins.size())) return false;
   const tinygltf::Skin& skin = m.skins[skin_index];
   const int nj = static_cast<int>(skin.joints.size());
   if (nj == 0) return false;
-  std::vector<Eigen::Matrix4d> M(nj);
-  Eigen::MatrixXd ib;
-  if (skin.inverseBindMatrices >= 0 &&
-      (!read_gltf_accessor(m, skin.inverseBindMatrices, &ib).ok() || ib.cols() != 16 || ib.rows() < nj)) {
+  Matrix4dList M;
+  if (!read_gltf_inverse_binds(m, skin, &M)) {
     *why = "its skin's inverseBindMatrices are unreadable";
     return false;
   }
   for (int j = 0; j < nj; ++j) {
     const int node = skin.joints[j];
     if (node < 0 || node >= static_cast<int>(world.size()) || !placed[node]) return false;
-    Eigen::Matrix4d inv = Eigen::Matrix4d::Identity();
-    if (ib.rows() > 0)
-      for (int k = 0; k < 16; ++k) inv(k % 4, k / 4) = ib(j, k);  // column-major
-    M[j] = world[node] * inv;
+    M[j] = world[node] * M[j];
   }
+  Eigen::MatrixXd J, W;
+  if (!read_gltf_skin_influences(m, prim, nv, &J, &W)) {
+    *why = "its JOINTS/WEIGHTS are unreadable";
+    return false;
+  }
+  if (J.cols() == 0) return false;
   A->setZero(nv, 12);
   Eigen::VectorXd total = Eigen::VectorXd::Zero(nv);
-  for (int set = 0; set < 4; ++set) {
-    const auto ji = prim.attributes.find("JOINTS_" + std::to_string(set));
-    const auto wi = prim.attributes.find("WEIGHTS_" + std::to_string(set));
-    if (ji == prim.attributes.end() || wi == prim.attributes.end()) {
-      if (set == 0) return false;
-      break;
-    }
-    Eigen::MatrixXd J, W;
-    if (!read_gltf_accessor(m, ji->second, &J).ok() || !read_gltf_accessor(m, wi->second, &W).ok() || J.rows() != nv ||
-        W.rows() != nv || J.cols() != 4 || W.cols() != 4) {
-      *why = "its JOINTS_" + std::to_string(set) + "/WEIGHTS_" + std::to_string(set) + " are unreadable";
-      return false;
-    }
-    for (Eigen::Index v = 0; v < nv; ++v)
-      for (int k = 0; k < 4; ++k) {
-        const double w = W(v, k);
-        if (!(w > 0)) continue;
-        const double jf = J(v, k);
-        if (!(jf >= 0 && jf < nj)) {
-          *why = "a vertex names joint " + std::to_string(static_cast<long long>(jf)) + " of a skin with " + std::to_string(nj);
-          return false;
-        }
-        const Eigen::Matrix4d& Mj = M[static_cast<int>(jf)];
-        for (int r = 0; r < 3; ++r) A->row(v).segment<4>(4 * r) += w * Mj.row(r);
-        total[v] += w;
+  for (Eigen::Index v = 0; v < nv; ++v)
+    for (Eigen::Index k = 0; k < J.cols(); ++k) {
+      const double w = W(v, k);
+      if (!(w > 0)) continue;
+      const double jf = J(v, k);
+      if (!(jf >= 0 && jf < nj)) {
+        *why = "a vertex names joint " + std::to_string(static_cast<long long>(jf)) + " of a skin with " + std::to_string(nj);
+        return false;
       }
-  }
+      const Eigen::Matrix4d& Mj = M[static_cast<int>(jf)];
+      for (int r = 0; r < 3; ++r) A->row(v).segment<4>(4 * r) += w * Mj.row(r);
+      total[v] += w;
+    }
   for (Eigen::Index v = 0; v < nv; ++v) {
     if (!(total[v] > 0)) return false;  // a vertex no joint moves: leave the primitive in its bind pose
     A->row(v) /= total[v];
   }
   return A->allFinite();
 }
-
 
 const tinygltf::Model* gltf_model(const Asset& asset) {
   const Document* d = asset.document.get();

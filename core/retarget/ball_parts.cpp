@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <utility>
 
 #include "mesh/topology.h"
 #include "mesh/weld.h"
@@ -20,17 +19,19 @@ std::vector<BallPart> ball_parts(const Eigen::MatrixXd& V, const Eigen::MatrixXi
   int count = 0;
   const Eigen::VectorXi comp = vertex_components(w.F, int(w.V.rows()), &count);
   if (count < 2) return out;
-  // Faces grouped by part; per part its undirected edges, to tell a closed part.
+  // A part is closed when each of its edges has exactly two faces (edge_uses: once for the mesh).
+  std::vector<char> open(count, 0);
+  for (const EdgeUse& e : edge_uses(w.F))
+    if (e.faces != 2) open[comp[e.i]] = 1;
   const VertexBuckets faces = bucket_by_vertex(count, int(w.F.rows()), [&](int f) { return comp[w.F(f, 0)]; });
   const double pi = 3.14159265358979323846;
-  std::vector<std::pair<int, int>> edges;
   for (int c = 0; c < count; ++c) {
+    if (open[c]) continue;
     const int begin = faces.start[c], end = faces.start[c + 1];
     if (end - begin < 4) continue;  // a closed surface has at least 4 triangles
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
     Eigen::Vector3d moment = Eigen::Vector3d::Zero();
     double area = 0, volume = 0;
-    edges.clear();
     for (int i = begin; i < end; ++i) {
       const int f = faces.items[i];
       const Eigen::Vector3d a = w.V.row(w.F(f, 0)).transpose(), b = w.V.row(w.F(f, 1)).transpose(),
@@ -43,21 +44,9 @@ std::vector<BallPart> ball_parts(const Eigen::MatrixXd& V, const Eigen::MatrixXi
       const double v = a.dot(b.cross(c3)) / 6.0;
       volume += v;
       moment += v * (a + b + c3) / 4.0;
-      for (int k = 0; k < 3; ++k) {
-        const int p = w.F(f, k), q = w.F(f, (k + 1) % 3);
-        edges.emplace_back(std::min(p, q), std::max(p, q));
-      }
     }
     if ((hi - lo).maxCoeff() > opt.max_size * height) continue;
-    std::sort(edges.begin(), edges.end());
-    bool closed = true;
-    for (size_t i = 0; i < edges.size() && closed;) {
-      size_t j = i;
-      while (j < edges.size() && edges[j] == edges[i]) ++j;
-      closed = j - i == 2;
-      i = j;
-    }
-    if (!closed || !(area > 0) || !(std::abs(volume) > 0)) continue;
+    if (!(area > 0) || !(std::abs(volume) > 0)) continue;
     const double vol = std::abs(volume);
     BallPart ball;
     ball.roundness = std::cbrt(pi) * std::pow(6.0 * vol, 2.0 / 3.0) / area;
