@@ -44,6 +44,8 @@ const OptionSchema<JointsJobOptions>& joints_options() {
              "outside the source's rig family, a joint's offset from its skeleton point is at most this x the skeleton's radius there (0 = off)");
     s.number("ball_joint_reach", [](O& o) -> double& { return o.fit.ball_joint_reach; }, 0, 100,
              "a target built of parts bends at its small round parts: a fitted joint within this x such a ball's radius of its centre moves there (0 = off)");
+    s.number("mirror_symmetry", [](O& o) -> double& { return o.fit.mirror_symmetry; }, 0, 1,
+             "a target that is its own mirror image to within this x its height (mean) gets mirror-image joint pairs (0 = off)");
     s.integer("marker_reach", [](O& o) -> int& { return o.fit.marker_reach; }, 0, 100,
               "markers also move joints up to this many bones away");
     s.number("marker_anchor", [](O& o) -> double& { return o.fit.marker_anchor; }, 0, 1,

@@ -587,6 +587,63 @@ TEST(JointFitting, BallPartsAreSmallClosedAndRound) {
   EXPECT_EQ(two[1], -1);
 }
 
+// Step 5e (forty-seventh session): human_woman is her own mirror image to 0.2 % of her height, but
+// CesiumMan's joints fitted into her were not: her knees came out 2.7 % of her height apart in
+// height, her ankles 4.3 %. With mirror pairs they are mirror images up to CesiumMan's own
+// asymmetry; against her hand-placed joints 3.28 → 2.99 % (19 joints), and the retargeted clip's
+// bone-length error 0.00457 → 0.00442 (hand-placed joints: 0.00434). Targets that are not their own
+// mirror image (the robot, arms hanging at different heights) are left alone.
+TEST(JointFitting, MirrorPairsOfASymmetricTarget) {
+  const JfCharacter cesium = jf_character("anim/CesiumMan/CesiumMan.glb");
+  const mm::io::LoadResult woman = mm::io::load_asset(mm::test::data_path("anim/human_woman.ply"));
+  ASSERT_TRUE(woman.status.ok());
+  const mm::io::JointSetResult truth = mm::io::parse_joints_json(jf_read("joints/human_woman_joints.json"));
+  ASSERT_TRUE(truth.status.ok());
+  mm::JointFitOptions off;
+  off.mirror_symmetry = 0;
+  const mm::JointFitResult on = mm::fit_joints(cesium.c.V_rest, cesium.c.F, cesium.joints, woman.asset.V_raw, woman.asset.F_raw);
+  const mm::JointFitResult without = mm::fit_joints(cesium.c.V_rest, cesium.c.F, cesium.joints, woman.asset.V_raw, woman.asset.F_raw, {}, off);
+  ASSERT_TRUE(on.status.ok() && without.status.ok());
+  const double H = jf_extent(woman.asset.V_raw, 1);
+  // Left–right mirror gap of a pair, across the plane x = c (the middle of the bounding box), × height h.
+  const auto mirror_gap = [](const mm::JointSet& J, const char* a, const char* b, double c, double h) {
+    const int i = J.find(a), j = J.find(b);
+    EXPECT_GE(i, 0);
+    EXPECT_GE(j, 0);
+    if (i < 0 || j < 0) return 1e9;
+    return (J.P.row(i) - Eigen::RowVector3d(2 * c - J.P(j, 0), J.P(j, 1), J.P(j, 2))).norm() / h;
+  };
+  const double cw = 0.5 * (woman.asset.V_raw.col(0).maxCoeff() + woman.asset.V_raw.col(0).minCoeff());
+  const double cc = 0.5 * (cesium.c.V_rest.col(0).maxCoeff() + cesium.c.V_rest.col(0).minCoeff()), Hc = jf_extent(cesium.c.V_rest, 1);
+  for (const auto& [a, b] : std::vector<std::pair<const char*, const char*>>{{"leg_joint_L_1", "leg_joint_R_1"},
+                                                                           {"leg_joint_L_2", "leg_joint_R_2"},
+                                                                           {"leg_joint_L_3", "leg_joint_R_3"},
+                                                                           {"Skeleton_arm_joint_L__4_", "Skeleton_arm_joint_R"},
+                                                                           {"Skeleton_arm_joint_L__2_", "Skeleton_arm_joint_R__3_"}}) {
+    const double g_on = mirror_gap(on.joints, a, b, cw, H), g_off = mirror_gap(without.joints, a, b, cw, H),
+                 own = mirror_gap(cesium.joints, a, b, cc, Hc);
+    std::cout << "[ CesiumMan in human_woman: mirror gap of " << a << " ] without " << g_off << ", with " << g_on
+              << " of her height (CesiumMan's own " << own << ")\n";
+    EXPECT_LT(g_on, own + 1e-3) << a;
+  }
+  EXPECT_GT(mirror_gap(without.joints, "leg_joint_L_2", "leg_joint_R_2", cw, H), 0.02);
+  EXPECT_GT(mirror_gap(without.joints, "leg_joint_L_3", "leg_joint_R_3", cw, H), 0.03);
+  EXPECT_EQ(on.mirrored, 14);  // 7 pairs: hips, knees, ankles, toes, shoulders, elbows, wrists
+  EXPECT_EQ(without.mirrored, 0);
+  const JfError e_on = jf_joint_error(on.joints, truth.joints, H), e_off = jf_joint_error(without.joints, truth.joints, H);
+  jf_print("CesiumMan joints in human_woman, mirror pairs off", e_off, without);
+  EXPECT_LT(e_on.mean, e_off.mean - 0.002);
+  // The robot's arms hang at different heights: no pairs are set in it.
+  const JfCharacter robot = jf_character("anim/RobotExpressive/RobotExpressive.glb");
+  const mm::JointFitResult in_robot = mm::fit_joints(cesium.c.V_rest, cesium.c.F, cesium.joints, robot.c.V_rest, robot.c.F, {}, [] {
+    mm::JointFitOptions o;
+    o.target_up = 1, o.target_front = 2;
+    return o;
+  }());
+  ASSERT_TRUE(in_robot.status.ok()) << in_robot.status.message;
+  EXPECT_EQ(in_robot.mirrored, 0);
+}
+
 // With a second thread the source's skeleton and tree are built on a pool task beside the
 // target's, and trees from 16k triangles up build their halves on two threads: the same joints,
 // bit for bit, on 1, 2 and 4 threads (CesiumMan in a subdivided woman: 55k triangles).
@@ -1178,7 +1235,8 @@ TEST(JointFittingRetarget, SkeletonPriorOnlyForTheSourcesRigFamily) {
 TEST(JointFittingRetarget, StaticTargetsBoneLengthsNoWorseThanHandPlaced) {
   // The retargeted clip's bone-length error with automatic joints against hand-placed ones.
   // Measured (twenty-eighth session): woman 0.00465 vs 0.00434 (7 % above), wolf 0.0104 vs 0.0095
-  // (10 % above): close, not "no worse". The bound allows 5 % plus 1e-3 of the height.
+  // (10 % above): close, not "no worse". The bound allows 5 % plus 1e-3 of the height. Forty-seventh
+  // session (mirror pairs, step 5e): woman 0.00442 (1.8 % above; 0.00457 before), wolf 0.01025.
   struct Case {
     const char* source;
     const char* target;

@@ -34,6 +34,9 @@
 //     or a mannequin's ball joints); a fitted joint that has reached one (each the other's nearest,
 //     within ball_joint_reach radii) moves to its centre — plus the source joint's offset from its
 //     own ball where the source has ball parts too, so a self fit stays exact;
+//  5e. a target that is its own mirror image gets mirror-image joint pairs: each joint with a mirror
+//     partner in the source becomes the mean of itself and its partner's mirror image, plus half
+//     the source's own asymmetry (a self fit stays exact);
 //  6. a joint outside the target is pulled toward its skeleton point until inside; markers pin
 //     named joints and drag their chain neighbours (weights fall off over marker_reach joints).
 // Source joints outside the source surface (roots on the floor, IK targets) are not placed.
@@ -103,6 +106,9 @@ struct JointFitOptions {
                                   // other's nearest) moves there, plus its source joint's offset from its own ball if the
                                   // source has one (0 = off)
   BallPartOptions balls;          // ... what counts as a ball part (retarget/ball_parts.h)
+  double mirror_symmetry = 0.01;  // step 5e: where source and target surfaces mirrored across their middle planes lie
+                                  // within this × height of themselves (mean), the fitted joint pairs are made mirror
+                                  // images, up to the source's own asymmetry (0 = off)
   int marker_reach = 3;           // markers move unpinned joints up to this many bones away (0 = only pin)
   double marker_anchor = 0.1;     // step 5: a marker within this × height of a target path between matched ends
                                   // anchors the proportions along it (0 = off)
@@ -128,6 +134,7 @@ struct JointFitResult {
   double skeleton_agreement = 0;  // step 5c: Σ|d − b| / Σ|b| of the fitted bones d against the source's b
   double skeleton_prior_used = 0; // the prior's weight after that gate (0: not applied)
   std::vector<std::string> ball_joints;  // step 5d: joints moved to the centre of a ball part of the target
+  int mirrored = 0;               // step 5e: joints set from themselves and their mirror partner (symmetric target)
 };
 
 // Vs/Fs: source rest surface; source_joints: its joints (names, positions, parents).

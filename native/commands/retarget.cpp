@@ -275,7 +275,9 @@ int run_joints(const std::vector<std::string>& argv) {
     std::cout << "weight " << fit.skeleton_prior_used;
   else
     std::cout << "not used";
-  std::cout << " (the fitted bones differ from the source's by " << fit.skeleton_agreement << ")\n  wrote " << out_path << "\n";
+  std::cout << " (the fitted bones differ from the source's by " << fit.skeleton_agreement << ")\n";
+  if (fit.mirrored > 0) std::cout << "  " << fit.mirrored << " joints made mirror images of their partners (a symmetric target)\n";
+  std::cout << "  wrote " << out_path << "\n";
   if (!debug_path.empty()) std::cout << "  wrote " << debug_path << "\n";
   return 0;
 }
