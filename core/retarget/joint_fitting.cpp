@@ -1316,12 +1316,12 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     const auto mirror = [](const Eigen::Vector3d& p, const Eigen::Vector3d& c, const Eigen::Vector3d& n) -> Eigen::Vector3d {
       return p - 2 * (p - c).dot(n) * n;
     };
-    // Mean distance of the mirrored surface from itself (up to 4000 vertices), × height.
+    // Mean distance of the mirrored surface from itself (every k-th vertex, ~1000), × height.
     const auto asymmetry = [&](const Eigen::MatrixXd& V, const TriangleBvh& bvh, const Eigen::Vector3d& c,
                                const Eigen::Vector3d& n, double height) {
       double sum = 0;
       int samples = 0;
-      const int stride = std::max(1, int(V.rows() / 4000));
+      const int stride = std::max(1, int(V.rows() / 1000));
       for (int i = 0; i < V.rows(); i += stride, ++samples) sum += std::sqrt(bvh.closest_point(mirror(V.row(i).transpose(), c, n)).sq_distance);
       return sum / std::max(1, samples) / height;
     };
