@@ -587,7 +587,7 @@ TEST(JointFitting, BallPartsAreSmallClosedAndRound) {
   EXPECT_EQ(two[1], -1);
 }
 
-// Step 5e (forty-seventh session): human_woman is her own mirror image to 0.2 % of her height, but
+// Step 5f (forty-seventh session): human_woman is her own mirror image to 0.2 % of her height, but
 // CesiumMan's joints fitted into her were not: her knees came out 2.7 % of her height apart in
 // height, her ankles 4.3 %. With mirror pairs they are mirror images up to CesiumMan's own
 // asymmetry; against her hand-placed joints 3.28 → 2.99 % (19 joints), and the retargeted clip's
@@ -642,6 +642,59 @@ TEST(JointFitting, MirrorPairsOfASymmetricTarget) {
   }());
   ASSERT_TRUE(in_robot.status.ok()) << in_robot.status.message;
   EXPECT_EQ(in_robot.mirrored, 0);
+}
+
+// Step 5e (forty-seventh session): a joint across a limb moves along the front axis to its source
+// joint's fraction of the limb's depth. With mirror pairs off (they average the two sides after
+// it), every moved joint of CesiumMan in human_woman sits at exactly CesiumMan's fraction; the
+// woman's hips, knees and ankles are among them, a quadruped's body joints (front is its longest
+// span) are not, and the robot's inner parts stop the rays (no move of a joint whose ray ends
+// inside the body).
+TEST(JointFitting, DepthFractionsAcrossLimbs) {
+  const JfCharacter cesium = jf_character("anim/CesiumMan/CesiumMan.glb");
+  const mm::io::LoadResult woman = mm::io::load_asset(mm::test::data_path("anim/human_woman.ply"));
+  ASSERT_TRUE(woman.status.ok());
+  mm::JointFitOptions on, off;
+  on.mirror_symmetry = off.mirror_symmetry = 0;
+  off.depth_span_ratio = 0;
+  const mm::JointFitResult a = mm::fit_joints(cesium.c.V_rest, cesium.c.F, cesium.joints, woman.asset.V_raw, woman.asset.F_raw, {}, on);
+  const mm::JointFitResult b = mm::fit_joints(cesium.c.V_rest, cesium.c.F, cesium.joints, woman.asset.V_raw, woman.asset.F_raw, {}, off);
+  ASSERT_TRUE(a.status.ok() && b.status.ok());
+  EXPECT_EQ(b.depth_moved, 0);
+  std::cout << "[ CesiumMan in human_woman ] " << a.depth_moved << " of " << a.joints.size() << " joints moved to CesiumMan's depth fractions\n";
+  EXPECT_GE(a.depth_moved, 8);
+  const mm::TriangleBvh sb(cesium.c.V_rest, cesium.c.F), tb(woman.asset.V_raw, woman.asset.F_raw);
+  const Eigen::Vector3d front = Eigen::Vector3d::UnitZ();  // glTF's front; the woman's file faces +z too
+  const auto depth_fraction = [&](const mm::TriangleBvh& bvh, const Eigen::Vector3d& p) {
+    const double behind = bvh.ray_first_hit(p, -front), ahead = bvh.ray_first_hit(p, front);
+    return behind > 0 && ahead > 0 ? behind / (behind + ahead) : std::nan("");
+  };
+  int at_fraction = 0;
+  for (int k = 0; k < a.joints.size(); ++k) {
+    const std::string& name = a.joints.names[k];
+    const double fs = depth_fraction(sb, cesium.joints.P.row(cesium.joints.find(name)).transpose());
+    const double fa = depth_fraction(tb, a.joints.P.row(k).transpose());
+    const double moved = (a.joints.P.row(k) - b.joints.P.row(b.joints.find(name))).norm();
+    if (moved > 0) {
+      EXPECT_NEAR(fa, fs, 1e-9) << name;
+      EXPECT_LT(moved, 0.05 * jf_extent(woman.asset.V_raw, 1)) << name;
+      ++at_fraction;
+    }
+  }
+  EXPECT_EQ(at_fraction, a.depth_moved);
+  for (const char* name : {"leg_joint_L_1", "leg_joint_R_1", "leg_joint_L_2", "leg_joint_R_2"}) {
+    const int k = a.joints.find(name);
+    EXPECT_GT((a.joints.P.row(k) - b.joints.P.row(b.joints.find(name))).norm(), 0) << name << " was not moved";
+  }
+  // The Fox in wolf0: the body's joints keep their place (front is the Fox's longest span there).
+  const JfCharacter fox = jf_character("anim/Fox/glTF-Binary/Fox.glb");
+  const mm::io::LoadResult wolf = mm::io::load_asset(mm::test::data_path("anim/wolf0.ply"));
+  ASSERT_TRUE(wolf.status.ok());
+  const mm::JointFitResult fa = mm::fit_joints(fox.c.V_rest, fox.c.F, fox.joints, wolf.asset.V_raw, wolf.asset.F_raw, {}, on);
+  const mm::JointFitResult fb = mm::fit_joints(fox.c.V_rest, fox.c.F, fox.joints, wolf.asset.V_raw, wolf.asset.F_raw, {}, off);
+  ASSERT_TRUE(fa.status.ok() && fb.status.ok());
+  for (const char* name : {"b_Hip_01", "b_Spine01_02", "b_Spine02_03", "b_Neck_04"})
+    EXPECT_EQ((fa.joints.P.row(fa.joints.find(name)) - fb.joints.P.row(fb.joints.find(name))).norm(), 0) << name;
 }
 
 // With a second thread the source's skeleton and tree are built on a pool task beside the
@@ -1236,14 +1289,17 @@ TEST(JointFittingRetarget, StaticTargetsBoneLengthsNoWorseThanHandPlaced) {
   // The retargeted clip's bone-length error with automatic joints against hand-placed ones.
   // Measured (twenty-eighth session): woman 0.00465 vs 0.00434 (7 % above), wolf 0.0104 vs 0.0095
   // (10 % above): close, not "no worse". The bound allows 5 % plus 1e-3 of the height. Forty-seventh
-  // session (mirror pairs, step 5e): woman 0.00442 (1.8 % above; 0.00457 before), wolf 0.01025.
+  // session (mirror pairs, step 5f): woman 0.00442 (1.8 % above; 0.00457 before), wolf 0.01025; with
+  // the depth fractions (step 5e): woman 0.00413, below the hand-placed joints' — the issue's "not
+  // worse" now holds and is asserted as it stands — and wolf 0.01043 (the wolf's is out of reach
+  // for a fit that follows the Fox's rig: WolfReferenceReadsTheFoxsJointsAnotherWay, below).
   struct Case {
     const char* source;
     const char* target;
     const char* joints;
     double bound;
   };
-  for (const Case& c : {Case{"anim/CesiumMan/CesiumMan.glb", "anim/human_woman.ply", "joints/human_woman_joints.json", 0.05},
+  for (const Case& c : {Case{"anim/CesiumMan/CesiumMan.glb", "anim/human_woman.ply", "joints/human_woman_joints.json", 0.0},
                         Case{"anim/Fox/glTF-Binary/Fox.glb", "anim/wolf0.ply", "joints/wolf0_joints.json", 0.095}}) {
     auto hand = jf_job(c.source, c.target, jf_read(c.joints));
     auto autoj = jf_job(c.source, c.target, "auto");
@@ -1259,7 +1315,7 @@ TEST(JointFittingRetarget, StaticTargetsBoneLengthsNoWorseThanHandPlaced) {
     std::cout << "[ " << c.source << " -> " << c.target << " bone-length error ] hand-placed mean " << bh.mean << " max "
               << bh.max << ", auto mean " << ba.mean << " max " << ba.max << " (" << hand->session.harmonic().bones().size()
               << " / " << autoj->session.harmonic().bones().size() << " bones)\n";
-    EXPECT_LE(ba.mean, bh.mean * 1.05 + 1e-3) << c.target;
+    EXPECT_LE(ba.mean, bh.mean * (1 + c.bound) + (c.bound > 0 ? 1e-3 : 0.0)) << c.target;
   }
 }
 

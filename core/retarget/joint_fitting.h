@@ -34,7 +34,9 @@
 //     or a mannequin's ball joints); a fitted joint that has reached one (each the other's nearest,
 //     within ball_joint_reach radii) moves to its centre — plus the source joint's offset from its
 //     own ball where the source has ball parts too, so a self fit stays exact;
-//  5e. a target that is its own mirror image gets mirror-image joint pairs: each joint with a mirror
+//  5e. a joint across a limb moves, along the front axis, to its source joint's fraction of the
+//     limb's depth (where both rays leave the body at their first hit and the depths compare);
+//  5f. a target that is its own mirror image gets mirror-image joint pairs: each joint with a mirror
 //     partner in the source becomes the mean of itself and its partner's mirror image, plus half
 //     the source's own asymmetry (a self fit stays exact);
 //  6. a joint outside the target is pulled toward its skeleton point until inside; markers pin
@@ -106,9 +108,11 @@ struct JointFitOptions {
                                   // other's nearest) moves there, plus its source joint's offset from its own ball if the
                                   // source has one (0 = off)
   BallPartOptions balls;          // ... what counts as a ball part (retarget/ball_parts.h)
-  double mirror_symmetry = 0.01;  // step 5e: where source and target surfaces mirrored across their middle planes lie
+  double mirror_symmetry = 0.01;  // step 5f: where source and target surfaces mirrored across their middle planes lie
                                   // within this × height of themselves (mean), the fitted joint pairs are made mirror
                                   // images, up to the source's own asymmetry (0 = off)
+  double depth_span_ratio = 2;    // step 5e: a joint across a limb moves to its source joint's fraction of the limb's
+                                  // front-to-back depth where the two depths (scaled) are within this ratio (≤ 1 = off)
   int marker_reach = 3;           // markers move unpinned joints up to this many bones away (0 = only pin)
   double marker_anchor = 0.1;     // step 5: a marker within this × height of a target path between matched ends
                                   // anchors the proportions along it (0 = off)
@@ -134,7 +138,8 @@ struct JointFitResult {
   double skeleton_agreement = 0;  // step 5c: Σ|d − b| / Σ|b| of the fitted bones d against the source's b
   double skeleton_prior_used = 0; // the prior's weight after that gate (0: not applied)
   std::vector<std::string> ball_joints;  // step 5d: joints moved to the centre of a ball part of the target
-  int mirrored = 0;               // step 5e: joints set from themselves and their mirror partner (symmetric target)
+  int depth_moved = 0;            // step 5e: joints moved to their source joint's fraction of the depth
+  int mirrored = 0;               // step 5f: joints set from themselves and their mirror partner (symmetric target)
 };
 
 // Vs/Fs: source rest surface; source_joints: its joints (names, positions, parents).
