@@ -1343,7 +1343,7 @@ TEST(JointFittingRetarget, WolfReferenceReadsTheFoxsJointsAnotherWay) {
   // The surface interval through p along ±axis, and p's fraction in it (NaN when a ray escapes).
   auto fraction = [](const mm::TriangleBvh& bvh, const Eigen::Vector3d& p, const Eigen::Vector3d& axis, Eigen::Vector2d* span) {
     const double below = bvh.ray_first_hit(p, -axis), above = bvh.ray_first_hit(p, axis);
-    if (!std::isfinite(below) || !std::isfinite(above)) return std::nan("");
+    if (!(below > 0) || !(above > 0)) return std::nan("");  // ray_first_hit: -1 when a ray escapes
     if (span) *span = {-below, above};
     return below / (below + above);
   };
