@@ -587,7 +587,7 @@ TEST(JointFitting, BallPartsAreSmallClosedAndRound) {
   EXPECT_EQ(two[1], -1);
 }
 
-// Step 5f (forty-seventh session): human_woman is her own mirror image to 0.2 % of her height, but
+// Step 5f (forty-seventh session): human_woman is her own mirror image within 0.2 % of her height, but
 // CesiumMan's joints fitted into her were not: her knees came out 2.7 % of her height apart in
 // height, her ankles 4.3 %. With mirror pairs they are mirror images up to CesiumMan's own
 // asymmetry; against her hand-placed joints 3.28 → 2.99 % (19 joints), and the retargeted clip's

@@ -1349,7 +1349,7 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     out.P = P;
   }
 
-  // 5f. Mirror pairs. A target that is its own mirror image (human_woman: 0.2 % of her height off)
+  // 5f. Mirror pairs. A target that is its own mirror image (human_woman: within 0.2 % of her height)
   // gets joint pairs that are mirror images too, up to the source's own asymmetry: the voxel
   // skeletons are not exactly symmetric, and her fitted knees came out 2.7 % of her height apart in
   // height, her ankles 4.3 %. Each joint whose mirror image in the source is another joint (within
