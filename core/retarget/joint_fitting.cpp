@@ -1316,13 +1316,15 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
           std::find(r.ball_joints.begin(), r.ball_joints.end(), out.names[k]) != r.ball_joints.end())
         continue;
       const Eigen::Vector3d ps = source_joints.P.row(src_of[k]).transpose();
-      // The source joint's spans along its three axes: front must not be the longest.
+      // The source joint's spans along its three axes: front must not be the longest. bs, fs_: its
+      // distances to the surface behind and ahead.
       int longest = -1;
-      double longest_span = -1;
+      double longest_span = -1, bs = -1, fs_ = -1;
       for (int a = 0; a < 3; ++a) {
         const double b = in.bvh_s.ray_first_hit(ps, -jf_axis(a)), f = in.bvh_s.ray_first_hit(ps, jf_axis(a));
         const double span = b > 0 && f > 0 ? b + f : std::numeric_limits<double>::infinity();
         if (span > longest_span) longest_span = span, longest = a;
+        if (a == front) bs = b, fs_ = f;
       }
       if (longest == front) continue;
       bool along_bone = false;
@@ -1335,7 +1337,6 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
       }
       if (along_bone) continue;
       const Eigen::Vector3d p = out.P.row(k).transpose();
-      const double bs = in.bvh_s.ray_first_hit(ps, -as), fs_ = in.bvh_s.ray_first_hit(ps, as);
       const double bt = bvh_t.ray_first_hit(p, -at), ft_ = bvh_t.ray_first_hit(p, at);
       if (!(bs > 0 && fs_ > 0 && bt > 0 && ft_ > 0)) continue;
       const double ratio = (bt + ft_) / ((bs + fs_) * ft.H / fs.H);
@@ -1348,6 +1349,12 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
     }
     out.P = P;
   }
+
+  // The two middle planes (steps 5f and the crossing check below): normal to up × front, through
+  // the centres of the bounding boxes.
+  const Eigen::Vector3d side = us.cross(jf_axis(opt.source_front));
+  const Eigen::Vector3d mid_s = 0.5 * (Vs.colwise().minCoeff() + Vs.colwise().maxCoeff()).transpose();
+  const Eigen::Vector3d mid_t = 0.5 * (Vt.colwise().minCoeff() + Vt.colwise().maxCoeff()).transpose();
 
   // 5f. Mirror pairs. A target that is its own mirror image (human_woman: within 0.2 % of her height)
   // gets joint pairs that are mirror images too, up to the source's own asymmetry: the voxel
@@ -1364,10 +1371,9 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
   // × height (mean distance of the mirrored vertices): RobotExpressive's arms hang at different
   // heights (1.24 %), and a source posed asymmetrically would carry its pose as its own asymmetry.
   if (opt.mirror_symmetry > 0 && out.size() > 1) {
-    const Eigen::Vector3d side_s = us.cross(jf_axis(opt.source_front)).normalized();
-    const Eigen::Vector3d side_t = R.transpose() * side_s;
-    // Centres of the bounding boxes: frames put o at the bottom centre (the up component is on the plane).
-    const Eigen::Vector3d cs = fs.o, ct = R.transpose() * ft.o;
+    const Eigen::Vector3d& side_s = side;
+    const Eigen::Vector3d side_t = R.transpose() * side;
+    const Eigen::Vector3d &cs = mid_s, &ct = mid_t;
     const auto mirror = [](const Eigen::Vector3d& p, const Eigen::Vector3d& c, const Eigen::Vector3d& n) -> Eigen::Vector3d {
       return p - 2 * (p - c).dot(n) * n;
     };
@@ -1380,16 +1386,18 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
       for (int i = 0; i < V.rows(); i += stride, ++samples) sum += std::sqrt(bvh.closest_point(mirror(V.row(i).transpose(), c, n)).sq_distance);
       return sum / std::max(1, samples) / height;
     };
-    const double asym_t = asymmetry(Vt, bvh_t, ct, side_t, ft.H), asym_s = asymmetry(Vs, in.bvh_s, cs, side_s, fs.H);
-    if (asym_t <= opt.mirror_symmetry && asym_s <= opt.mirror_symmetry) {
-      const int n = out.size();
-      std::vector<int> partner(n, -1);
-      for (int k = 0; k < n; ++k) {
-        const Eigen::Vector3d m = mirror(source_joints.P.row(src_of[k]).transpose(), cs, side_s);
-        double best = 0.03 * fs.H;
-        for (int l = 0; l < n; ++l)
-          if (const double d = (source_joints.P.row(src_of[l]).transpose() - m).norm(); d < best) best = d, partner[k] = l;
-      }
+    const int n = out.size();
+    std::vector<int> partner(n, -1);
+    bool pairs = false;
+    for (int k = 0; k < n; ++k) {
+      const Eigen::Vector3d m = mirror(source_joints.P.row(src_of[k]).transpose(), cs, side_s);
+      double best = 0.03 * fs.H;
+      for (int l = 0; l < n; ++l)
+        if (const double d = (source_joints.P.row(src_of[l]).transpose() - m).norm(); d < best) best = d, partner[k] = l;
+    }
+    for (int k = 0; k < n; ++k) pairs = pairs || (partner[k] >= 0 && partner[k] != k && partner[partner[k]] == k);
+    if (pairs && asymmetry(Vt, bvh_t, ct, side_t, ft.H) <= opt.mirror_symmetry &&
+        asymmetry(Vs, in.bvh_s, cs, side_s, fs.H) <= opt.mirror_symmetry) {
       const double scale = ft.H / fs.H;
       Eigen::MatrixXd P = out.P;
       for (int k = 0; k < n; ++k) {
@@ -1414,15 +1422,12 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
   // each leg ran from one hip to the other foot; mean error 21 %, bones' disagreement only 0.40)
   // says so; the whole fit turned round is not caught here.
   {
-    const Eigen::Vector3d side = us.cross(jf_axis(opt.source_front));
-    const Eigen::Vector3d cs = 0.5 * (Vs.colwise().minCoeff() + Vs.colwise().maxCoeff()).transpose();
-    const Eigen::Vector3d ct = 0.5 * (Vt.colwise().minCoeff() + Vt.colwise().maxCoeff()).transpose();
     auto side_s = [&](int k) {
-      const double x = side.dot(source_joints.P.row(src_of[k]).transpose() - cs) / fs.H;
+      const double x = side.dot(source_joints.P.row(src_of[k]).transpose() - mid_s) / fs.H;
       return x > 0.05 ? 1 : x < -0.05 ? -1 : 0;
     };
     auto side_t = [&](int k) {
-      const double x = side.dot(R * (out.P.row(k).transpose() - ct)) / ft.H;
+      const double x = side.dot(R * (out.P.row(k).transpose() - mid_t)) / ft.H;
       return x > 0.01 ? 1 : x < -0.01 ? -1 : 0;
     };
     std::vector<std::string> crossing;
