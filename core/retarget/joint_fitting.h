@@ -113,6 +113,9 @@ struct JointFitOptions {
                                   // images, up to the source's own asymmetry (0 = off)
   double depth_span_ratio = 2;    // step 5e: a joint across a limb moves to its source joint's fraction of the limb's
                                   // front-to-back depth where the two depths (scaled) are within this ratio (≤ 1 = off)
+  double middle_span_ratio = 3;   // step 5e: a joint on the source's middle plane moves sideways to its source joint's
+                                  // fraction of the body's width where the two widths (scaled) are within this ratio
+                                  // (≤ 1 = off)
   int marker_reach = 3;           // markers move unpinned joints up to this many bones away (0 = only pin)
   double marker_anchor = 0.1;     // step 5: a marker within this × height of a target path between matched ends
                                   // anchors the proportions along it (0 = off)
@@ -139,6 +142,7 @@ struct JointFitResult {
   double skeleton_prior_used = 0; // the prior's weight after that gate (0: not applied)
   std::vector<std::string> ball_joints;  // step 5d: joints moved to the centre of a ball part of the target
   int depth_moved = 0;            // step 5e: joints moved to their source joint's fraction of the depth
+  int middle_moved = 0;           // step 5e: middle joints moved to their source joint's fraction of the width
   int mirrored = 0;               // step 5f: joints set from themselves and their mirror partner (symmetric target)
 };
 
