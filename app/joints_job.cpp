@@ -36,6 +36,8 @@ const OptionSchema<JointsJobOptions>& joints_options() {
               "rounds of moving each joint by the local affine map of the source surface around it onto the target (0 = off)");
     s.number("surface_refine_sigma", [](O& o) -> double& { return o.fit.surface_refine_sigma; }, 0.1, 10,
              "that neighbourhood: Gaussian sigma = this x the joint's depth below the source surface");
+    s.boolean("surface_refine_seen", [](O& o) -> bool& { return o.fit.surface_refine_seen; },
+              "the surface around a joint is only what the joint sees through the source's solid (not a neighbouring limb across empty space)");
     s.number("skeleton_prior", [](O& o) -> double& { return o.fit.skeleton_prior; }, 0, 100,
              "weight of the source's bones (scaled to the target) against the fitted joints, for a target of the source's rig family (0 = off)");
     s.number("skeleton_prior_agreement", [](O& o) -> double& { return o.fit.skeleton_prior_agreement; }, 0, 10,

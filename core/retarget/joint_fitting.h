@@ -98,6 +98,8 @@ struct JointFitOptions {
   int surface_refine_iterations = 3; // step 5b: joints moved by the local affine map of the surfaces around them (0 = off)
   double surface_refine_sigma = 2.5; // its neighbourhood: Gaussian σ = this × the joint's depth below the source surface
   double surface_refine_ridge = 0.1; // its affine fit's ridge toward a pure translation, × the neighbourhood's spread
+  bool surface_refine_seen = true;   // ... only the surface seen from the joint through the source's solid (not a
+                                     // neighbouring limb across empty space)
   double surface_refine_max_move = 2;// a joint moves at most this × its depth inside the target (≥ 0.01 × height)
   double skeleton_prior = 2;       // step 5c: weight of the source's bones (scaled into the target) against the fit (0 = off)
   double skeleton_prior_agreement = 0.15;  // ... full while the fitted bones differ from those by ≤ this (Σ|d − b| / Σ|b|),
