@@ -51,7 +51,7 @@ const OptionSchema<JointsJobOptions>& joints_options() {
     s.number("depth_span_ratio", [](O& o) -> double& { return o.fit.depth_span_ratio; }, 0, 100,
              "a joint across a limb moves to its source joint's fraction of the limb's front-to-back depth where the two depths are within this ratio (<= 1 = off)");
     s.number("middle_span_ratio", [](O& o) -> double& { return o.fit.middle_span_ratio; }, 0, 100,
-             "a joint on the source's middle plane moves sideways to its source joint's fraction of the body's width where the two widths are within this ratio (<= 1 = off)");
+             "a joint on the source's middle plane where limbs branch off to both sides moves sideways to the middle of the target's section plus its source joint's offset, where the two widths are within this ratio (<= 1 = off)");
     s.integer("marker_reach", [](O& o) -> int& { return o.fit.marker_reach; }, 0, 100,
               "markers also move joints up to this many bones away");
     s.number("marker_anchor", [](O& o) -> double& { return o.fit.marker_anchor; }, 0, 1,

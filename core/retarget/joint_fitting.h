@@ -29,13 +29,16 @@
 //  5b. each joint is then moved by the local affine map that takes the source surface around it
 //     (posed onto the fitted joints bone by bone) to its closest target points — a joint centred
 //     in a thigh stays centred in a thicker one; a few rounds, each move at most twice the
-//     joint's depth (measured: Knight's joints in Barbarian 0.78 → 0.60 % of the height);
+//     joint's depth (measured: Knight's joints in Barbarian 0.78 → 0.60 % of the height); the
+//     surface around a joint is what it sees through the source's solid (not the other leg);
 //  5d. a target built of separate parts bends at its ball parts (small closed round parts: a robot's
 //     or a mannequin's ball joints); a fitted joint that has reached one (each the other's nearest,
 //     within ball_joint_reach radii) moves to its centre — plus the source joint's offset from its
 //     own ball where the source has ball parts too, so a self fit stays exact;
 //  5e. a joint across a limb moves, along the front axis, to its source joint's fraction of the
 //     limb's depth (where both rays leave the body at their first hit and the depths compare);
+//     a joint on the middle where limbs branch off to both sides (hips, chest) moves sideways to
+//     the middle of the target's section plus the source joint's own offset from the middle;
 //  5f. a target that is its own mirror image gets mirror-image joint pairs: each joint with a mirror
 //     partner in the source becomes the mean of itself and its partner's mirror image, plus half
 //     the source's own asymmetry (a self fit stays exact);
@@ -115,9 +118,9 @@ struct JointFitOptions {
                                   // images, up to the source's own asymmetry (0 = off)
   double depth_span_ratio = 2;    // step 5e: a joint across a limb moves to its source joint's fraction of the limb's
                                   // front-to-back depth where the two depths (scaled) are within this ratio (≤ 1 = off)
-  double middle_span_ratio = 3;   // step 5e: a joint on the source's middle plane moves sideways to its source joint's
-                                  // fraction of the body's width where the two widths (scaled) are within this ratio
-                                  // (≤ 1 = off)
+  double middle_span_ratio = 3;   // step 5e: a joint on the source's middle plane where limbs branch off to both sides
+                                  // moves sideways to the middle of the target's section plus the source joint's offset
+                                  // from its own, where the two widths (scaled) are within this ratio (≤ 1 = off)
   int marker_reach = 3;           // markers move unpinned joints up to this many bones away (0 = only pin)
   double marker_anchor = 0.1;     // step 5: a marker within this × height of a target path between matched ends
                                   // anchors the proportions along it (0 = off)
@@ -144,7 +147,7 @@ struct JointFitResult {
   double skeleton_prior_used = 0; // the prior's weight after that gate (0: not applied)
   std::vector<std::string> ball_joints;  // step 5d: joints moved to the centre of a ball part of the target
   int depth_moved = 0;            // step 5e: joints moved to their source joint's fraction of the depth
-  int middle_moved = 0;           // step 5e: middle joints moved to their source joint's fraction of the width
+  int middle_moved = 0;           // step 5e: middle joints moved sideways to the middle of the target's section
   int mirrored = 0;               // step 5f: joints set from themselves and their mirror partner (symmetric target)
 };
 

@@ -276,7 +276,7 @@ int run_joints(const std::vector<std::string>& argv) {
   else
     std::cout << "not used";
   std::cout << " (the fitted bones differ from the source's by " << fit.skeleton_agreement << ")\n";
-  if (fit.middle_moved > 0) std::cout << "  " << fit.middle_moved << " middle joints moved to the source's fraction of the body's width\n";
+  if (fit.middle_moved > 0) std::cout << "  " << fit.middle_moved << " middle joints moved sideways to the middle of the target's body\n";
   if (fit.depth_moved > 0) std::cout << "  " << fit.depth_moved << " joints moved to the source's fraction of their limb's depth\n";
   if (fit.mirrored > 0) std::cout << "  " << fit.mirrored << " joints made mirror images of their partners (a symmetric target)\n";
   std::cout << "  wrote " << out_path << "\n";
