@@ -14,24 +14,6 @@ Eigen::Matrix3d rotation_between(const Eigen::Vector3d& a, const Eigen::Vector3d
   return Eigen::Quaterniond::FromTwoVectors(a, b).toRotationMatrix();
 }
 
-// Distances along the ray p + s·dir (unit dir) at which it crosses the surface, nearest first,
-// up to max_s and at most max_hits of them. After a hit the ray restarts `step` past it (a hit
-// on an edge shared by two triangles counts once); callers pass the same step to rays they
-// compare, so that both see the same crossings.
-std::vector<double> ray_hits(const TriangleBvh& bvh, const Eigen::Vector3d& p, const Eigen::Vector3d& dir,
-                             double max_s, int max_hits, double step) {
-  std::vector<double> hits;
-  double s0 = 0;
-  while (static_cast<int>(hits.size()) < max_hits) {
-    const double s = bvh.ray_first_hit(p + s0 * dir, dir, max_s - s0);
-    if (s < 0) break;
-    hits.push_back(s0 + s);
-    s0 += s + step;
-    if (s0 >= max_s) break;
-  }
-  return hits;
-}
-
 }  // namespace retarget_detail
 
 BoneCorrespondence bone_correspondence(const Eigen::MatrixXd& Y, const std::vector<std::pair<int, int>>& bones,
@@ -98,8 +80,8 @@ BoneCorrespondence bone_correspondence(const Eigen::MatrixXd& Y, const std::vect
     // distance, not by counting crossings, keeps the choice stable when a ray grazes an edge
     // (a crossing counted on one platform and missed on another).
     const double step = 1e-6 * len;
-    const std::vector<double> ht = retarget_detail::ray_hits(bvh_t, qb[pick], o / len, 4 * len, 16, step);
-    const std::vector<double> hs = retarget_detail::ray_hits(bvh_s, qs, dir, 8 * len, 16, step);
+    const std::vector<double> ht = bvh_t.ray_crossings(qb[pick], o / len, 4 * len, 16, step);
+    const std::vector<double> hs = bvh_s.ray_crossings(qs, dir, 8 * len, 16, step);
     auto nearest = [](const std::vector<double>& h, double target) {
       double best = h[0];
       for (double s : h)

@@ -1392,17 +1392,13 @@ JointFitResult jf_fit_on_skeletons(JointFitResult r, const JfInputs& in, bool so
   // to 0.012 in human_woman: her clip's bone-length error 0.00413 → 0.00433); every middle joint
   // (wolf0's tail joints centred onto each other: its bone-length error 0.01043 → 0.01102).
   if (opt.middle_span_ratio > 1 && r.skeleton_prior_used == 0) {
-    const Eigen::Vector3d as = side.normalized(), at = R.transpose() * as;
+    const Eigen::Vector3d& as = side;  // unit: two distinct coordinate axes
+    const Eigen::Vector3d at = R.transpose() * as;
     auto on_middle = [&](int k) { return std::abs(as.dot(source_joints.P.row(src_of[k]).transpose() - mid_s)) <= 0.01 * fs.H; };
+    // The first of the ray's (up to 32) crossings past which it is outside every part, or −1.
     auto exit_distance = [](const TriangleBvh& bvh, const Eigen::Vector3d& p, const Eigen::Vector3d& dir, double eps) {
-      double t = 0;
-      for (int hop = 0; hop < 32; ++hop) {
-        const double h = bvh.ray_first_hit(p + t * dir, dir);
-        if (!(h >= 0)) return -1.0;
-        t += h;
+      for (double t : bvh.ray_crossings(p, dir, std::numeric_limits<double>::infinity(), 32, eps))
         if (!bvh.inside(p + (t + eps) * dir)) return t;
-        t += eps;
-      }
       return -1.0;
     };
     for (int k = 0; k < out.size(); ++k) {

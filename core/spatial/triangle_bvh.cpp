@@ -255,6 +255,20 @@ int TriangleBvh::ray_winding(const Eigen::Vector3d& p, const Eigen::Vector3d& di
   return winding;
 }
 
+std::vector<double> TriangleBvh::ray_crossings(const Eigen::Vector3d& p, const Eigen::Vector3d& dir, double max_s,
+                                               int max_hits, double step) const {
+  std::vector<double> hits;
+  double s0 = 0;
+  while (static_cast<int>(hits.size()) < max_hits) {
+    const double s = ray_first_hit(p + s0 * dir, dir, max_s - s0);
+    if (s < 0) break;
+    hits.push_back(s0 + s);
+    s0 += s + step;
+    if (s0 >= max_s) break;
+  }
+  return hits;
+}
+
 double TriangleBvh::ray_first_hit(const Eigen::Vector3d& p, const Eigen::Vector3d& dir, double max_s) const {
   if (nodes_.empty()) return -1;
   const Eigen::Vector3d inv = dir.cwiseInverse();

@@ -55,6 +55,11 @@ class TriangleBvh {
   // is in units of dir), or -1 when nothing is hit within s ≤ max_s.
   double ray_first_hit(const Eigen::Vector3d& p, const Eigen::Vector3d& dir,
                        double max_s = std::numeric_limits<double>::infinity()) const;
+  // Distances along the ray p + s·dir at which it crosses the surface, nearest first, up to
+  // max_s and at most max_hits of them. After a hit the ray restarts `step` past it (a hit on an
+  // edge shared by two triangles counts once); rays to be compared should use the same step.
+  std::vector<double> ray_crossings(const Eigen::Vector3d& p, const Eigen::Vector3d& dir, double max_s, int max_hits,
+                                    double step) const;
 
   // Inside test robust to small holes and to inverted parts: casts 7 fixed rays and says
   // "inside" when most of them see |winding| ≥ 1. After enough queries (LazyInsideGrids below)
